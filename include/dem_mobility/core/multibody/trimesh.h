@@ -1,0 +1,63 @@
+// Triangle meshes and a static terrain surface with a uniform 2-D grid index.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+#include <vector>
+
+namespace dem_mobility {
+
+/// A plain triangle mesh (vertices and faces, counter-clockwise seen from outside).
+struct TriMesh {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<int, 3>> faces;
+  Eigen::Vector3d FaceNormal(size_t f) const;
+};
+
+/// A flat rectangular road of triangles in the z = 0 plane: [x0, x0+length] x [-width/2, width/2],
+/// split into cells of `cell` metres, two triangles each.
+TriMesh MakeFlatRoad(double x0, double length, double width, double cell);
+
+/// A static terrain surface: a triangle mesh that faces up (+z of its frame), with a uniform grid
+/// over x-y so that a point query only touches the triangles of one cell. Penetration is measured
+/// along each triangle's normal. Gravity, not the mesh, carries the grade.
+class TerrainMesh {
+ public:
+  /// `cell`: grid cell size [m]; `max_depth`: deepest penetration that still counts as contact
+  /// (beyond it the point is taken to be behind the surface, not in it).
+  TerrainMesh(TriMesh mesh, double cell, double max_depth);
+
+  struct Hit {
+    double depth = 0.0;           ///< penetration (> 0 in contact)
+    Eigen::Vector3d normal;       ///< outward unit normal of the triangle
+    int face = -1;
+  };
+  /// Deepest penetrating triangle under point p (x-y projection), if any.
+  bool Query(const Eigen::Vector3d& p, Hit* hit) const;
+  /// Highest surface point over the x-y box [lo, hi] (conservative: the cells' maxima).
+  double MaxHeight(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const;
+
+  const TriMesh& mesh() const { return mesh_; }
+  double max_depth() const { return max_depth_; }
+  size_t num_cells() const { return cell_zmax_.size(); }
+
+ private:
+  struct Face {
+    Eigen::Vector3d n;  ///< unit normal
+    double offset;      ///< n . p0
+    Eigen::Vector2d o;  ///< x-y of vertex 0
+    Eigen::Matrix2d inv;///< maps (p - p0).xy to barycentric (l1, l2)
+  };
+  int CellIndex(int ix, int iy) const { return iy * nx_ + ix; }
+  TriMesh mesh_;
+  std::vector<Face> faces_;
+  double cell_, max_depth_;
+  Eigen::Vector2d origin_;
+  int nx_ = 0, ny_ = 0;
+  std::vector<int> cell_start_;  ///< CSR: faces of cell i are cell_faces_[cell_start_[i]..[i+1])
+  std::vector<int> cell_faces_;
+  std::vector<double> cell_zmax_;
+};
+
+}  // namespace dem_mobility

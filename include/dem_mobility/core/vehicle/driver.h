@@ -1,0 +1,48 @@
+// The driver of the paper's scenario (sections 4.1, 4.3): accelerate at a commanded rate from rest
+// toward a top speed, within the engine's torque limits, braking when the request is below what
+// the engine brake can give.
+#pragma once
+
+#include "dem_mobility/core/vehicle/powertrain.h"
+
+namespace dem_mobility {
+
+class YamlReader;
+
+struct DriverParams {
+  double accel = 1.0;         ///< commanded acceleration [m/s^2]
+  double v_max = 25.0;        ///< commanded top speed [m/s]
+  double kp = 0.0;            ///< speed feedback [N per m/s]
+  double ki = 0.0;            ///< integral feedback [N per m]
+  bool full_throttle = false; ///< ignore the profile: request WOT all the time
+  static DriverParams Read(const YamlReader& y);
+};
+
+/// Command produced each step.
+struct DriverCommand {
+  double speed_command = 0.0;   ///< [m/s]
+  double torque_request = 0.0;  ///< drive-shaft torque asked for [N m] (before the engine clamp)
+  double drive_torque = 0.0;    ///< after the clamp between engine-brake and WOT curves [N m]
+  double brake_effort = 0.0;    ///< [0, 1]
+  bool wot_limited = false;     ///< the request exceeds the WOT curve (full throttle)
+};
+
+/// Speed controller: force = m a_cmd + kp e + ki int(e); drive-shaft torque = force r / G, where G
+/// is the driveline reduction (wheel speed / drive-shaft speed) and r the wheel radius.
+class SpeedDriver {
+ public:
+  SpeedDriver(const DriverParams& p, const PowertrainParams& pt, double vehicle_mass, double wheel_radius,
+              double reduction);
+  /// Speed command of the profile at time t (from the driver's start).
+  double SpeedCommand(double t) const;
+  /// Advances the controller by dt at time t with forward speed v and drive-shaft speed w_ds.
+  DriverCommand Update(double t, double dt, double v, double w_ds);
+
+ private:
+  DriverParams p_;
+  const PowertrainParams& pt_;
+  double mass_, radius_, reduction_;
+  double integral_ = 0.0;
+};
+
+}  // namespace dem_mobility

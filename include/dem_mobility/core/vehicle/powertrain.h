@@ -1,0 +1,27 @@
+// Drive torque limits (WOT and engine-brake curves at the drive shaft, paper fig. 16) and brakes
+// (maximum torque versus wheel speed, fig. 17).
+#pragma once
+
+#include "dem_mobility/core/common/table.h"
+
+namespace dem_mobility {
+
+class YamlReader;
+
+struct PowertrainParams {
+  Table1D wot;            ///< drive-shaft speed [rad/s] -> maximum drive torque [N m]
+  Table1D engine_brake;   ///< drive-shaft speed [rad/s] -> minimum (most negative) torque [N m]
+  Table1D brake_max;      ///< wheel speed [rad/s] -> maximum brake torque per wheel [N m]
+  double brake_speed_eps = 0.05;  ///< [rad/s] brake torque fades to zero below this wheel speed
+
+  /// Reads wot_torque, engine_brake_torque and brakes from a powertrain file; checks that the
+  /// engine-brake curve lies below the WOT curve at every tabulated speed.
+  static PowertrainParams Read(const YamlReader& y);
+
+  /// The drive torque actually applied: the request clamped between the two curves at `w_ds`.
+  double ClampDriveTorque(double request, double w_ds) const;
+  /// Brake torque on a wheel spinning at `w_rel` relative to its upright (opposes the spin).
+  double BrakeTorque(double effort, double w_rel) const;
+};
+
+}  // namespace dem_mobility

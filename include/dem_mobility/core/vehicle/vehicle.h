@@ -1,0 +1,81 @@
+// The 33-body HMMWV-type vehicle of the paper (section 4.1), assembled from YAML.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+
+#include "dem_mobility/core/multibody/multibody_system.h"
+#include "dem_mobility/core/vehicle/powertrain.h"
+
+namespace dem_mobility {
+
+/// Wheel order everywhere: front left, front right, rear left, rear right.
+enum WheelIndex { kFrontLeft = 0, kFrontRight = 1, kRearLeft = 2, kRearRight = 3 };
+
+/// A vehicle assembled in a MultibodySystem: chassis; per corner upper and lower control arms,
+/// upright (knuckle) and wheel; steering rack and two tie rods; drive shaft; per axle pinion,
+/// carrier, two side gears and two half shafts. Penalty joints connect them (revolute = two
+/// spherical points on the axis); gears, differentials and CV joints are penalty couplings.
+///
+/// The drive torque request and brake effort are set from outside; every force evaluation clamps
+/// the drive torque between the engine-brake and WOT curves at the current drive-shaft speed and
+/// turns the brake effort into wheel torques at the current wheel speeds.
+class Vehicle {
+ public:
+  /// Builds the vehicle described by `file` with its chassis reference frame at `position` (world),
+  /// wheels in contact with `terrain` (may be null: no tire contact) using `tire_contact`.
+  /// Throws ConfigError naming the file and key of any bad or unknown input.
+  static std::unique_ptr<Vehicle> Load(const std::string& file, const TerrainMesh* terrain,
+                                       const ContactParams& tire_contact, const Eigen::Vector3d& position);
+
+  MultibodySystem& system() { return system_; }
+  const MultibodySystem& system() const { return system_; }
+  const PowertrainParams& powertrain() const { return powertrain_; }
+  const TireGeometry& tire() const { return tire_; }
+  const std::string& name() const { return name_; }
+
+  int chassis() const { return chassis_; }
+  /// Wheel speed / drive-shaft speed when all wheels turn alike (the final drive ratio).
+  double driveline_reduction() const { return reduction_; }
+  int wheel(int i) const { return wheels_[i]; }
+  /// Distance from the ground plane under a wheel to the chassis reference frame at design.
+  double design_ride_height() const { return ride_height_; }
+  /// Chassis reference-frame origin in world coordinates (the chassis COM minus its offset).
+  Eigen::Vector3d ChassisFramePosition() const;
+
+  double ForwardSpeed() const;       ///< chassis COM velocity along the chassis x axis [m/s]
+  double DriveShaftSpeed() const;    ///< relative to the chassis [rad/s]
+  double WheelSpeed(int i) const;    ///< spin relative to the upright [rad/s]
+  double WheelLoad(int i) const;     ///< normal contact force on the tire, last evaluation [N]
+  const ContactSummary& TireContactSummary(int i) const;
+
+  void SetDriveTorqueRequest(double t) { drive_request_ = t; }
+  void SetBrakeEffort(double effort) { brake_effort_ = effort; }
+  /// Steering as a fraction of full lock in [-1, 1] (positive: left).
+  void SetSteering(double fraction);
+  double AppliedDriveTorque() const;
+  double BrakeEffort() const { return brake_effort_; }
+
+ private:
+  Vehicle() = default;
+  void ApplyPowertrain(MultibodySystem& sys);
+
+  MultibodySystem system_;
+  PowertrainParams powertrain_;
+  TireGeometry tire_;
+  std::string name_;
+  int chassis_ = -1;
+  std::array<int, 4> wheels_{};
+  std::array<int, 4> uprights_{};
+  std::array<int, 4> brakes_{};   ///< indices into system_.torques
+  int drive_ = -1;                ///< index into system_.torques
+  int steering_ = -1;             ///< index into system_.line_constraints
+  double max_rack_travel_ = 0.0;
+  double reduction_ = 0.0;
+  Eigen::Vector3d chassis_com_offset_ = Eigen::Vector3d::Zero();
+  double ride_height_ = 0.0;
+  double drive_request_ = 0.0, brake_effort_ = 0.0;
+};
+
+}  // namespace dem_mobility

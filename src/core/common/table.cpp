@@ -1,0 +1,56 @@
+#include "dem_mobility/core/common/table.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dem_mobility/core/common/error.h"
+
+namespace dem_mobility {
+
+Table1D::Table1D(std::vector<double> x, std::vector<double> y, const std::string& what)
+    : x_(std::move(x)), y_(std::move(y)) {
+  DM_THROW_UNLESS(!x_.empty(), what, ": a table needs at least one point");
+  DM_THROW_UNLESS(x_.size() == y_.size(), what, ": ", x_.size(), " x values but ", y_.size(),
+                  " y values");
+  for (size_t i = 0; i < x_.size(); ++i) {
+    DM_THROW_UNLESS(std::isfinite(x_[i]) && std::isfinite(y_[i]), what, ": point ", i,
+                    " is not finite");
+    if (i > 0)
+      DM_THROW_UNLESS(x_[i] > x_[i - 1], what, ": x must increase strictly, but point ", i, " has x = ",
+                      x_[i], " after ", x_[i - 1]);
+  }
+}
+
+double Table1D::operator()(double x) const {
+  if (x <= x_.front()) return y_.front();
+  if (x >= x_.back()) return y_.back();
+  const size_t i = std::upper_bound(x_.begin(), x_.end(), x) - x_.begin();  // x_[i-1] < x < x_[i]
+  const double t = (x - x_[i - 1]) / (x_[i] - x_[i - 1]);
+  return y_[i - 1] + t * (y_[i] - y_[i - 1]);
+}
+
+double Table1D::IntegralFromFirst(double x) const {
+  if (x <= x_.front()) return (x - x_.front()) * y_.front();
+  double sum = 0.0;
+  for (size_t i = 1; i < x_.size(); ++i) {
+    if (x <= x_[i]) {
+      const double yx = (*this)(x);
+      return sum + 0.5 * (y_[i - 1] + yx) * (x - x_[i - 1]);
+    }
+    sum += 0.5 * (y_[i - 1] + y_[i]) * (x_[i] - x_[i - 1]);
+  }
+  return sum + (x - x_.back()) * y_.back();
+}
+
+double Table1D::Integral(double x0, double x1) const {
+  return IntegralFromFirst(x1) - IntegralFromFirst(x0);
+}
+
+double Table1D::MaxSlope() const {
+  double s = 0.0;
+  for (size_t i = 1; i < x_.size(); ++i)
+    s = std::max(s, std::abs((y_[i] - y_[i - 1]) / (x_[i] - x_[i - 1])));
+  return s;
+}
+
+}  // namespace dem_mobility

@@ -1,0 +1,216 @@
+#include "dem_mobility/core/common/yaml_reader.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace dem_mobility {
+
+namespace {
+std::string Show(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "(nothing)";
+  if (n.IsScalar()) return "'" + n.Scalar() + "'";
+  YAML::Emitter e;
+  e << YAML::Flow << n;
+  return e.c_str();
+}
+std::string Dirname(const std::string& p) {
+  const auto pos = p.find_last_of('/');
+  return pos == std::string::npos ? std::string(".") : p.substr(0, pos);
+}
+}  // namespace
+
+YamlReader::YamlReader(YAML::Node node, std::string file, std::string path)
+    : node_(std::move(node)),
+      file_(std::move(file)),
+      path_(std::move(path)),
+      used_(std::make_shared<std::set<std::string>>()) {}
+
+YamlReader YamlReader::Load(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path + ": cannot open file (missing or unreadable)");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return FromString(ss.str(), path);
+}
+
+YamlReader YamlReader::FromString(const std::string& text, const std::string& name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(name + ": malformed YAML: " + e.what());
+  }
+  if (!root.IsMap()) throw ConfigError(name + ": the top level must be a map of keys");
+  return YamlReader(root, name, "");
+}
+
+std::string YamlReader::Where(const std::string& key) const {
+  std::string p = path_.empty() ? key : (key.empty() ? path_ : path_ + "." + key);
+  return file_ + ": " + (p.empty() ? "(top level)" : p);
+}
+
+void YamlReader::Fail(const std::string& key, const std::string& message) const {
+  throw ConfigError(Where(key) + ": " + message);
+}
+
+bool YamlReader::Has(const std::string& key) const {
+  if (!node_.IsMap()) return false;
+  const YAML::Node n = node_[key];
+  if (n.IsDefined()) used_->insert(key);
+  return n.IsDefined() && !n.IsNull();
+}
+
+YAML::Node YamlReader::Get(const std::string& key) const {
+  if (!node_.IsMap()) Fail("", "expected a map of keys, found " + Show(node_));
+  const YAML::Node n = node_[key];
+  if (!n.IsDefined() || n.IsNull()) Fail(key, "missing required key");
+  used_->insert(key);
+  return n;
+}
+
+template <typename T>
+T YamlReader::As(const std::string& key, const YAML::Node& n, const char* what) const {
+  try {
+    if (!n.IsScalar()) throw YAML::Exception(YAML::Mark(), "not a scalar");
+    return n.as<T>();
+  } catch (const YAML::Exception&) {
+    Fail(key, std::string("expected ") + what + ", found " + Show(n));
+  }
+}
+
+double YamlReader::Double(const std::string& key) const {
+  const double v = As<double>(key, Get(key), "a number");
+  if (!std::isfinite(v)) Fail(key, "value " + Show(node_[key]) + " is not finite");
+  return v;
+}
+double YamlReader::Double(const std::string& key, double fallback) const {
+  return Has(key) ? Double(key) : fallback;
+}
+double YamlReader::DoubleIn(const std::string& key, double lo, double hi) const {
+  const double v = Double(key);
+  if (v < lo || v > hi)
+    Fail(key, detail::Concat("value ", v, " is outside the allowed range [", lo, ", ", hi, "]"));
+  return v;
+}
+double YamlReader::DoubleIn(const std::string& key, double lo, double hi, double fallback) const {
+  return Has(key) ? DoubleIn(key, lo, hi) : fallback;
+}
+double YamlReader::Positive(const std::string& key) const {
+  const double v = Double(key);
+  if (!(v > 0.0)) Fail(key, detail::Concat("value ", v, " must be positive"));
+  return v;
+}
+double YamlReader::Positive(const std::string& key, double fallback) const {
+  return Has(key) ? Positive(key) : fallback;
+}
+double YamlReader::NonNegative(const std::string& key) const {
+  const double v = Double(key);
+  if (v < 0.0) Fail(key, detail::Concat("value ", v, " must not be negative"));
+  return v;
+}
+double YamlReader::NonNegative(const std::string& key, double fallback) const {
+  return Has(key) ? NonNegative(key) : fallback;
+}
+int YamlReader::Int(const std::string& key) const { return As<int>(key, Get(key), "an integer"); }
+int YamlReader::Int(const std::string& key, int fallback) const {
+  return Has(key) ? Int(key) : fallback;
+}
+bool YamlReader::Bool(const std::string& key, bool fallback) const {
+  return Has(key) ? As<bool>(key, Get(key), "true or false") : fallback;
+}
+std::string YamlReader::String(const std::string& key) const {
+  return As<std::string>(key, Get(key), "a string");
+}
+std::string YamlReader::String(const std::string& key, const std::string& fallback) const {
+  return Has(key) ? String(key) : fallback;
+}
+
+std::vector<double> YamlReader::DoubleList(const std::string& key) const {
+  const YAML::Node n = Get(key);
+  if (!n.IsSequence()) Fail(key, "expected a list of numbers, found " + Show(n));
+  std::vector<double> out;
+  for (size_t i = 0; i < n.size(); ++i) {
+    try {
+      out.push_back(n[i].as<double>());
+    } catch (const YAML::Exception&) {
+      Fail(key, "element " + std::to_string(i) + " is not a number: " + Show(n[i]));
+    }
+    if (!std::isfinite(out.back())) Fail(key, "element " + std::to_string(i) + " is not finite");
+  }
+  return out;
+}
+
+Eigen::Vector3d YamlReader::Vector3(const std::string& key) const {
+  const std::vector<double> v = DoubleList(key);
+  if (v.size() != 3) Fail(key, "expected 3 numbers [x, y, z], found " + Show(node_[key]));
+  return {v[0], v[1], v[2]};
+}
+Eigen::Vector3d YamlReader::Vector3(const std::string& key, const Eigen::Vector3d& fallback) const {
+  return Has(key) ? Vector3(key) : fallback;
+}
+
+Table1D YamlReader::Table(const std::string& key) const {
+  const YAML::Node n = Get(key);
+  if (!n.IsSequence() || n.size() == 0)
+    Fail(key, "expected a non-empty list of [x, y] pairs, found " + Show(n));
+  std::vector<double> x, y;
+  for (size_t i = 0; i < n.size(); ++i) {
+    if (!n[i].IsSequence() || n[i].size() != 2)
+      Fail(key, "row " + std::to_string(i) + " must be a pair [x, y], found " + Show(n[i]));
+    try {
+      x.push_back(n[i][0].as<double>());
+      y.push_back(n[i][1].as<double>());
+    } catch (const YAML::Exception&) {
+      Fail(key, "row " + std::to_string(i) + " is not a pair of numbers: " + Show(n[i]));
+    }
+  }
+  try {
+    return Table1D(x, y, Where(key));
+  } catch (const ConfigError& e) {
+    throw;
+  }
+}
+
+YamlReader YamlReader::Child(const std::string& key) const {
+  const YAML::Node n = Get(key);
+  if (!n.IsMap()) Fail(key, "expected a map of keys, found " + Show(n));
+  return YamlReader(n, file_, path_.empty() ? key : path_ + "." + key);
+}
+
+bool YamlReader::IsSequence(const std::string& key) const {
+  return node_.IsMap() && node_[key].IsDefined() && node_[key].IsSequence();
+}
+
+std::vector<YamlReader> YamlReader::Sequence(const std::string& key) const {
+  const YAML::Node n = Get(key);
+  if (!n.IsSequence()) Fail(key, "expected a list, found " + Show(n));
+  std::vector<YamlReader> out;
+  for (size_t i = 0; i < n.size(); ++i)
+    out.emplace_back(n[i], file_, (path_.empty() ? key : path_ + "." + key) + "[" + std::to_string(i) + "]");
+  return out;
+}
+
+std::vector<std::string> YamlReader::Keys() const {
+  std::vector<std::string> keys;
+  if (!node_.IsMap()) return keys;
+  for (const auto& kv : node_) keys.push_back(kv.first.as<std::string>());
+  return keys;
+}
+
+std::string YamlReader::ResolvePath(const std::string& relative) const {
+  if (!relative.empty() && relative[0] == '/') return relative;
+  return Dirname(file_) + "/" + relative;
+}
+
+void YamlReader::Finish() const {
+  if (!node_.IsMap()) return;
+  std::string unknown;
+  for (const auto& kv : node_) {
+    const std::string k = kv.first.as<std::string>();
+    if (!used_->count(k)) unknown += (unknown.empty() ? "" : ", ") + k;
+  }
+  if (!unknown.empty()) Fail("", "unknown key(s): " + unknown);
+}
+
+}  // namespace dem_mobility

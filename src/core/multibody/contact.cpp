@@ -1,0 +1,238 @@
+#include "dem_mobility/core/multibody/contact.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+
+namespace dem_mobility {
+
+using Eigen::Vector3d;
+
+ContactParams ContactParams::Read(const YamlReader& y) {
+  ContactParams p;
+  p.k_n = y.Positive("k_n");
+  p.c_n = y.NonNegative("c_n");
+  p.s_n = y.DoubleIn("s_n", 0.0, 1.0);
+  p.mu = y.NonNegative("mu");
+  p.k_t = y.Positive("k_t");
+  p.c_t_anchor = y.NonNegative("c_t_anchor", 0.0);
+  p.v_slip = y.Positive("v_slip", 0.01);
+  p.c_visc = y.NonNegative("c_visc", 0.0);
+  p.c_rr = y.DoubleIn("c_rr", 0.0, 0.5, 0.0);
+  return p;
+}
+
+Vector3d ContactForce(const ContactParams& p, const Vector3d& point, const Vector3d& n, double depth,
+                      const Vector3d& v, long step, ContactHistory* h, double* normal_force) {
+  // normal: repulsion k d plus damping, reduced by s_n while separating (eq. 11-12)
+  const double vn = n.dot(v);
+  const double d_dot = -vn;  // penetration rate
+  const double f_rep = p.k_n * depth;
+  const double f_damp = d_dot >= 0.0 ? p.c_n * d_dot : p.s_n * p.c_n * d_dot;
+  const double fn = std::max(0.0, f_rep + f_damp);
+  *normal_force = fn;
+
+  // tangential: asperity friction (anchor spring || Coulomb element), capped at mu F_repulsion
+  const Vector3d surface = point + depth * n;
+  if (h->last_step != step - 1 && h->last_step != step) h->anchor = surface;
+  h->last_step = step;
+  const Vector3d vt = v - vn * n;
+  Vector3d delta = surface - h->anchor;
+  delta -= delta.dot(n) * n;
+  const double vt_norm = vt.norm();
+  Vector3d f_c = Vector3d::Zero();
+  if (vt_norm > 0.0) f_c = (-p.mu * f_rep * std::min(1.0, vt_norm / p.v_slip) / vt_norm) * vt;
+  const Vector3d f_spring = -p.k_t * delta - p.c_t_anchor * vt;
+  Vector3d f_t = f_spring + f_c;
+  const double limit = p.mu * f_rep;
+  const double ft_norm = f_t.norm();
+  if (ft_norm > limit) {
+    f_t *= limit / ft_norm;
+    // slip: move the anchor so that the spring carries what the Coulomb element does not
+    h->anchor = surface + (f_t - f_c) / p.k_t;
+    h->anchor -= (h->anchor - surface).dot(n) * n;
+  }
+  return fn * n + f_t - p.c_visc * vt;
+}
+
+// ---------------------------------------------------------------------------------------------
+namespace {
+void Accumulate(ContactSummary* s, const Vector3d& f, const Vector3d& r, double fn, double depth) {
+  s->force += f;
+  s->torque += r.cross(f);
+  s->normal_force += fn;
+  s->max_depth = std::max(s->max_depth, depth);
+  ++s->num_contacts;
+}
+double ContactPointEnergy(const ContactParams& p, const TerrainMesh& t, const Vector3d& x,
+                          const ContactHistory& h, long step) {
+  TerrainMesh::Hit hit;
+  if (!t.Query(x, &hit)) return 0.0;
+  double e = 0.5 * p.k_n * hit.depth * hit.depth;
+  if (h.last_step == step) {
+    Vector3d delta = x + hit.depth * hit.normal - h.anchor;
+    delta -= delta.dot(hit.normal) * hit.normal;
+    e += 0.5 * p.k_t * delta.squaredNorm();
+  }
+  return e;
+}
+}  // namespace
+
+void PointSetContact::Apply(Bodies& bodies, long step) {
+  RigidBody& B = bodies[body];
+  if (history.size() != points.size()) history.resize(points.size());
+  last = ContactSummary();
+  applied_step = step;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Vector3d r = B.R * points[i];
+    const Vector3d x = B.x + r;
+    TerrainMesh::Hit hit;
+    if (!terrain->Query(x, &hit)) continue;
+    double fn;
+    const Vector3d f = ContactForce(params, x, hit.normal, hit.depth, B.VelocityAt(r), step, &history[i], &fn);
+    B.AddForceAt(f, r);
+    Accumulate(&last, f, r, fn, hit.depth);
+  }
+}
+double PointSetContact::PotentialEnergy(const Bodies& bodies) const {
+  double e = 0.0;
+  const RigidBody& B = bodies[body];
+  for (size_t i = 0; i < points.size() && i < history.size(); ++i)
+    e += ContactPointEnergy(params, *terrain, B.PointWorld(points[i]), history[i], applied_step);
+  return e;
+}
+StiffnessInfo PointSetContact::Stiffness(const Bodies& bodies) const {
+  // all points in contact at once: sum of the rank-one stiffnesses bounds the largest eigenvalue
+  const RigidBody& B = bodies[body];
+  double w2 = 0.0;
+  const double k = std::max(params.k_n, params.k_t);
+  for (const auto& p : points) w2 += k * InverseEffectiveMass(B, B.R * p);
+  StiffnessInfo s;
+  if (w2 <= 0) return s;
+  s.omega = std::sqrt(w2);
+  const double m_eff = points.size() * k / w2;
+  s.zeta = params.c_n / (2.0 * std::sqrt(k * m_eff));
+  s.detail = detail::Concat(points.size(), " points of k = ", k, " N/m on body '", B.name, "' ", B.mass, " kg");
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+TireGeometry TireGeometry::Make(double radius, double width, double shoulder_radius, int n_circ, int n_lat) {
+  DM_THROW_UNLESS(radius > 0 && width > 0, "tire: radius and width must be positive");
+  DM_THROW_UNLESS(shoulder_radius >= 0 && 2 * shoulder_radius <= width && shoulder_radius < radius,
+                  "tire: shoulder_radius must be in [0, width/2]");
+  DM_THROW_UNLESS(n_circ >= 8 && n_lat >= 2, "tire: need n_circ >= 8 and n_lat >= 2");
+  TireGeometry g;
+  g.radius = radius;
+  g.width = width;
+  g.shoulder_radius = shoulder_radius;
+  g.n_circ = n_circ;
+  g.n_lat = n_lat;
+  const double flat = 0.5 * width - shoulder_radius;
+  for (int j = 0; j < n_lat; ++j) {
+    const double y = -0.5 * width + width * j / (n_lat - 1);
+    double r = radius;
+    if (std::abs(y) > flat) {
+      const double e = std::abs(y) - flat;
+      r = radius - shoulder_radius + std::sqrt(std::max(0.0, shoulder_radius * shoulder_radius - e * e));
+    }
+    g.lat_y.push_back(y);
+    g.lat_r.push_back(r);
+  }
+  for (int c = 0; c < n_circ; ++c) {
+    const double phi = 2.0 * M_PI * c / n_circ;
+    for (int j = 0; j < n_lat; ++j)
+      g.mesh.vertices.emplace_back(g.lat_r[j] * std::cos(phi), g.lat_y[j], g.lat_r[j] * std::sin(phi));
+  }
+  for (int c = 0; c < n_circ; ++c) {
+    const int c1 = (c + 1) % n_circ;
+    for (int j = 0; j + 1 < n_lat; ++j) {
+      const int v00 = c * n_lat + j, v01 = c * n_lat + j + 1, v10 = c1 * n_lat + j, v11 = c1 * n_lat + j + 1;
+      g.mesh.faces.push_back({v00, v01, v10});
+      g.mesh.faces.push_back({v01, v11, v10});
+    }
+  }
+  return g;
+}
+
+void TireContact::Apply(Bodies& bodies, long step) {
+  RigidBody& B = bodies[body];
+  const TireGeometry& T = *tire;
+  if (history.size() != T.mesh.vertices.size()) history.resize(T.mesh.vertices.size());
+  last = ContactSummary();
+  applied_step = step;
+  columns_tested = 0;
+  const Vector3d u = B.R.col(0), a = B.R.col(1), w = B.R.col(2);
+  const double reach = T.radius + 0.5 * T.width;
+  const double zmax = terrain->MaxHeight(B.x.head<2>().array() - reach, B.x.head<2>().array() + reach);
+  if (!std::isfinite(zmax)) return;
+  // vertex z = x_z - r rho cos(phi - phi_down) + y a_z: only the columns that can reach zmax
+  const double rho = std::hypot(u.z(), w.z());
+  int c_lo = 0, c_hi = T.n_circ - 1;
+  if (rho > 1e-9) {
+    const double q = (B.x.z() - 0.5 * T.width * std::abs(a.z()) - zmax) / (T.radius * rho);
+    if (q > 1.0) return;
+    if (q > -1.0) {
+      const double phi_down = std::atan2(-w.z(), -u.z());
+      const double half = std::acos(q);
+      const double dphi = 2.0 * M_PI / T.n_circ;
+      c_lo = static_cast<int>(std::floor((phi_down - half) / dphi));
+      c_hi = static_cast<int>(std::ceil((phi_down + half) / dphi));
+      if (c_hi - c_lo >= T.n_circ) {
+        c_lo = 0;
+        c_hi = T.n_circ - 1;
+      }
+    }
+  }
+  for (int cc = c_lo; cc <= c_hi; ++cc) {
+    const int c = ((cc % T.n_circ) + T.n_circ) % T.n_circ;
+    ++columns_tested;
+    for (int j = 0; j < T.n_lat; ++j) {
+      const int vi = c * T.n_lat + j;
+      const Vector3d r = B.R * T.mesh.vertices[vi];
+      const Vector3d x = B.x + r;
+      TerrainMesh::Hit hit;
+      if (!terrain->Query(x, &hit)) continue;
+      double fn;
+      const Vector3d f = ContactForce(params, x, hit.normal, hit.depth, B.VelocityAt(r), step, &history[vi], &fn);
+      B.AddForceAt(f, r);
+      Accumulate(&last, f, r, fn, hit.depth);
+    }
+  }
+  // rolling resistance: a moment c_rr R F_n opposing the spin, regularised near zero spin
+  if (params.c_rr > 0.0 && last.normal_force > 0.0) {
+    const double spin = B.w_world.dot(a);
+    const double w_eps = params.v_slip / T.radius;
+    const double m = -params.c_rr * T.radius * last.normal_force * std::clamp(spin / w_eps, -1.0, 1.0);
+    B.torque += m * a;
+    last.torque += m * a;
+  }
+}
+double TireContact::PotentialEnergy(const Bodies& bodies) const {
+  double e = 0.0;
+  const RigidBody& B = bodies[body];
+  for (size_t i = 0; i < history.size(); ++i)
+    if (history[i].last_step == applied_step)
+      e += ContactPointEnergy(params, *terrain, B.PointWorld(tire->mesh.vertices[i]), history[i], applied_step);
+  return e;
+}
+StiffnessInfo TireContact::Stiffness(const Bodies& bodies) const {
+  // vertices that can be in contact at once: the columns within the terrain's max_depth
+  const RigidBody& B = bodies[body];
+  const double half = std::acos(std::max(-1.0, 1.0 - terrain->max_depth() / tire->radius));
+  const int cols = 1 + 2 * static_cast<int>(std::ceil(half / (2.0 * M_PI / tire->n_circ)));
+  const int n = std::min(tire->n_circ, cols) * tire->n_lat;
+  const double k = std::max(params.k_n, params.k_t);
+  const double w2 = n * k * InverseEffectiveMass(B, Vector3d(0, 0, tire->radius));
+  StiffnessInfo s;
+  s.omega = std::sqrt(w2);
+  const double m_eff = n * k / w2;
+  s.zeta = params.c_n * n / (2.0 * std::sqrt(n * k * m_eff));
+  s.detail = detail::Concat(n, " tire vertices of k = ", k, " N/m on '", B.name, "' ", B.mass, " kg");
+  return s;
+}
+
+}  // namespace dem_mobility

@@ -1,0 +1,186 @@
+#include "dem_mobility/core/multibody/multibody_system.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <cmath>
+#include <limits>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/rotation.h"
+
+namespace dem_mobility {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+MultibodySystem::MultibodySystem() {
+  RigidBody ground;
+  ground.name = "ground";
+  ground.fixed = true;
+  bodies_.push_back(ground);
+}
+
+int MultibodySystem::AddBody(RigidBody b) {
+  DM_THROW_UNLESS(!finalized_, "body '", b.name, "': cannot add bodies after Finalize()");
+  DM_THROW_UNLESS(FindBody(b.name) < 0, "body '", b.name, "' is defined twice");
+  if (!b.fixed) {
+    DM_THROW_UNLESS(std::isfinite(b.mass) && b.mass > 0.0, "body '", b.name, "': mass ", b.mass,
+                    " kg must be positive");
+    DM_THROW_UNLESS(b.inertia.allFinite() && (b.inertia - b.inertia.transpose()).norm() <= 1e-9 * b.inertia.norm(),
+                    "body '", b.name, "': inertia must be a finite symmetric matrix");
+    Eigen::SelfAdjointEigenSolver<Matrix3d> es(b.inertia);
+    const Vector3d ev = es.eigenvalues();
+    DM_THROW_UNLESS(ev.minCoeff() > 0.0, "body '", b.name, "': inertia is not positive definite (principal moments ",
+                    ev.transpose(), " kg m^2)");
+    DM_THROW_UNLESS(ev(0) + ev(1) >= ev(2) * (1.0 - 1e-9), "body '", b.name, "': principal moments ", ev.transpose(),
+                    " kg m^2 violate the triangle inequality (no physical body has them)");
+    b.inv_mass = 1.0 / b.mass;
+    b.inv_inertia = b.inertia.inverse();
+    b.min_inertia = ev.minCoeff();
+  } else {
+    b.inv_mass = 0.0;
+    b.inv_inertia.setZero();
+  }
+  b.w_world = b.R * b.w;
+  bodies_.push_back(std::move(b));
+  return static_cast<int>(bodies_.size()) - 1;
+}
+
+int MultibodySystem::FindBody(const std::string& name) const {
+  for (size_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+TimeStepLimit MultibodySystem::CriticalTimeStep() const {
+  TimeStepLimit lim;
+  lim.dt_crit = std::numeric_limits<double>::infinity();
+  auto consider = [&lim](const std::string& kind, const std::string& name, const StiffnessInfo& s) {
+    const double dt = CriticalStep(s.omega, s.zeta);
+    if (dt < lim.dt_crit) {
+      lim.dt_crit = dt;
+      lim.element = kind + " '" + name + "'";
+      lim.detail = s.detail;
+    }
+  };
+  for (const auto& e : point_joints) consider("joint", e.name, e.Stiffness(bodies_));
+  for (const auto& e : perpendicular_axes) consider("joint", e.name, e.Stiffness(bodies_));
+  for (const auto& e : orientation_locks) consider("joint", e.name, e.Stiffness(bodies_));
+  for (const auto& e : line_constraints) consider("joint", e.name, e.Stiffness(bodies_));
+  for (const auto& e : couplings) consider("coupling", e.name, e.Stiffness(bodies_));
+  for (const auto& e : cv_twists) consider("joint", e.name, e.Stiffness(bodies_));
+  for (const auto& e : springs) consider("spring", e.name, e.Stiffness(bodies_));
+  for (const auto& e : point_contacts) consider("contact", e.name, e.Stiffness(bodies_));
+  for (const auto& e : tire_contacts) consider("contact", e.name, e.Stiffness(bodies_));
+  return lim;
+}
+
+void MultibodySystem::Finalize(double dt) {
+  DM_THROW_UNLESS(std::isfinite(dt) && dt > 0.0, "time step dt = ", dt, " s must be positive");
+  const TimeStepLimit lim = CriticalTimeStep();
+  DM_THROW_UNLESS(dt <= lim.dt_crit, "time step dt = ", dt, " s is above the critical step ", lim.dt_crit,
+                  " s of ", lim.element, " (", lim.detail, "); use dt <= ", lim.dt_crit,
+                  " s or soften that element");
+  for (const auto& c : point_contacts) DM_THROW_UNLESS(c.terrain != nullptr, "contact '", c.name, "' has no terrain");
+  for (const auto& c : tire_contacts)
+    DM_THROW_UNLESS(c.terrain != nullptr && c.tire != nullptr, "tire contact '", c.name, "' has no terrain or tire");
+  dt_ = dt;
+  finalized_ = true;
+  ComputeForces();
+}
+
+void MultibodySystem::ComputeForces() {
+  for (RigidBody& b : bodies_) {
+    b.w_world = b.R * b.w;
+    b.force = b.mass * gravity_ + b.ext_force;
+    b.torque = b.ext_torque;
+  }
+  if (pre_force_hook) pre_force_hook(*this);
+  for (const auto& e : point_joints) e.Apply(bodies_);
+  for (const auto& e : perpendicular_axes) e.Apply(bodies_);
+  for (const auto& e : orientation_locks) e.Apply(bodies_);
+  for (const auto& e : line_constraints) e.Apply(bodies_);
+  for (const auto& e : couplings) e.Apply(bodies_);
+  for (const auto& e : cv_twists) e.Apply(bodies_);
+  for (const auto& e : springs) e.Apply(bodies_);
+  for (const auto& e : torques) e.Apply(bodies_);
+  for (auto& e : point_contacts) e.Apply(bodies_, step_);
+  for (auto& e : tire_contacts) e.Apply(bodies_, step_);
+  for (RigidBody& b : bodies_) {
+    if (b.fixed) continue;
+    b.accel = b.inv_mass * b.force;
+    const Vector3d t_body = b.R.transpose() * b.torque;
+    b.alpha = b.inv_inertia * (t_body - b.w.cross(b.inertia * b.w));  // eq. 2
+  }
+}
+
+void MultibodySystem::Step() {
+  DM_DEMAND(finalized_);
+  const double dt = dt_, h = 0.5 * dt_;
+  for (RigidBody& b : bodies_) {
+    if (b.fixed) continue;
+    b.v += h * b.accel;                 // first half of eq. 3a / 4a
+    b.w += h * b.alpha;
+    b.x += dt * b.v;                    // x + dt v + dt^2/2 a
+    b.R = b.R * ExpRotation(dt * b.w);  // eq. 5 with dtheta = dt w(t + dt/2)
+    b.w_world = b.R * b.w;
+  }
+  for (auto& c : couplings) c.Integrate(bodies_, dt);
+  if ((step_ & 63) == 63)
+    for (RigidBody& b : bodies_) Reorthonormalize(b.R);
+  time_ += dt;
+  ++step_;
+  ComputeForces();
+  for (RigidBody& b : bodies_) {
+    if (b.fixed) continue;
+    b.v += h * b.accel;  // second half of eq. 3a / 4a
+    b.w += h * b.alpha;
+  }
+  CheckFinite();
+}
+
+void MultibodySystem::CheckFinite() const {
+  for (const RigidBody& b : bodies_) {
+    if (b.fixed) continue;
+    if (!(b.x.allFinite() && b.v.allFinite() && b.w.allFinite()))
+      throw SimulationError(detail::Concat("step ", step_, " (t = ", time_, " s): body '", b.name,
+                                           "' has a non-finite state (x = ", b.x.transpose(), ", v = ",
+                                           b.v.transpose(), ", w = ", b.w.transpose(),
+                                           "); the time step is too large or an input is NaN"));
+  }
+}
+
+EnergyReport MultibodySystem::Energy() const {
+  EnergyReport e;
+  for (const RigidBody& b : bodies_) {
+    if (b.fixed) continue;
+    e.kinetic += b.KineticEnergy();
+    e.gravitational -= b.mass * gravity_.dot(b.x);
+  }
+  for (const auto& x : point_joints) e.elastic += x.PotentialEnergy(bodies_);
+  for (const auto& x : perpendicular_axes) e.elastic += x.PotentialEnergy(bodies_);
+  for (const auto& x : orientation_locks) e.elastic += x.PotentialEnergy(bodies_);
+  for (const auto& x : line_constraints) e.elastic += x.PotentialEnergy(bodies_);
+  for (const auto& x : couplings) e.elastic += x.PotentialEnergy(bodies_);
+  for (const auto& x : cv_twists) e.elastic += x.PotentialEnergy(bodies_);
+  for (const auto& x : springs) e.elastic += x.PotentialEnergy(bodies_);
+  for (const auto& x : point_contacts) e.elastic += x.PotentialEnergy(bodies_);
+  for (const auto& x : tire_contacts) e.elastic += x.PotentialEnergy(bodies_);
+  return e;
+}
+
+double MultibodySystem::TotalMass() const {
+  double m = 0.0;
+  for (const RigidBody& b : bodies_)
+    if (!b.fixed) m += b.mass;
+  return m;
+}
+
+Vector3d MultibodySystem::CenterOfMass() const {
+  Vector3d c = Vector3d::Zero();
+  for (const RigidBody& b : bodies_)
+    if (!b.fixed) c += b.mass * b.x;
+  return c / TotalMass();
+}
+
+}  // namespace dem_mobility
