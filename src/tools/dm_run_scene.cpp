@@ -40,8 +40,7 @@ void ApplyOverride(YAML::Node root, const std::string& file, const std::string& 
     if (!next.IsMap()) throw ConfigError(file + ": override '" + kv + "': '" + parts[i] + "' is not a map in the scene");
     chain.push_back(next);
   }
-  if (!chain.back()[parts.back()].IsDefined())
-    throw ConfigError(file + ": override '" + kv + "': the scene has no key '" + key + "'");
+  // a key the scene does not have is added; the strict reader then rejects it if it is unknown
   chain.back()[parts.back()] = YAML::Load(value);
 }
 }  // namespace

@@ -158,6 +158,12 @@ TireGeometry TireGeometry::Make(double radius, double width, double shoulder_rad
   return g;
 }
 
+namespace {
+Vector3d Vertex(const TireGeometry& t, int col, int j) {
+  return t.Vertex(((col % t.n_circ) + t.n_circ) % t.n_circ, j);
+}
+}  // namespace
+
 void TireContact::Apply(Bodies& bodies, long step) {
   RigidBody& B = bodies[body];
   const TireGeometry& T = *tire;
@@ -187,6 +193,17 @@ void TireContact::Apply(Bodies& bodies, long step) {
       }
     }
   }
+  // fast path: the tested columns lie over cells tiled by one plane (flat road)
+  Vector3d plane_n;
+  double plane_off = 0.0;
+  bool planar = false;
+  if (c_hi - c_lo + 1 < T.n_circ / 4) {
+    const Vector3d p0 = B.x + B.R * Vertex(T, c_lo, 0), p1 = B.x + B.R * Vertex(T, c_hi, 0);
+    const Eigen::Vector2d ext = (0.5 * T.width * a).head<2>().cwiseAbs() +
+                                Eigen::Vector2d::Constant(4.0 * M_PI * T.radius / T.n_circ);
+    planar = terrain->BoxPlane(p0.head<2>().cwiseMin(p1.head<2>()) - ext, p0.head<2>().cwiseMax(p1.head<2>()) + ext,
+                               &plane_n, &plane_off);
+  }
   for (int cc = c_lo; cc <= c_hi; ++cc) {
     const int c = ((cc % T.n_circ) + T.n_circ) % T.n_circ;
     ++columns_tested;
@@ -195,7 +212,13 @@ void TireContact::Apply(Bodies& bodies, long step) {
       const Vector3d r = B.R * T.mesh.vertices[vi];
       const Vector3d x = B.x + r;
       TerrainMesh::Hit hit;
-      if (!terrain->Query(x, &hit)) continue;
+      if (planar) {
+        hit.depth = plane_off - plane_n.dot(x);
+        if (hit.depth <= 0.0 || hit.depth > terrain->max_depth()) continue;
+        hit.normal = plane_n;
+      } else if (!terrain->Query(x, &hit)) {
+        continue;
+      }
       double fn;
       const Vector3d f = ContactForce(params, x, hit.normal, hit.depth, B.VelocityAt(r), step, &history[vi], &fn);
       B.AddForceAt(f, r);

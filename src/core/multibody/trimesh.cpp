@@ -75,16 +75,46 @@ TerrainMesh::TerrainMesh(TriMesh mesh, double cell, double max_depth)
     const Vector2d flo = p0.head<2>().cwiseMin(p1.head<2>()).cwiseMin(p2.head<2>());
     const Vector2d fhi = p0.head<2>().cwiseMax(p1.head<2>()).cwiseMax(p2.head<2>());
     const double zmax = std::max({p0.z(), p1.z(), p2.z()});
-    const int ix0 = std::clamp(static_cast<int>(std::floor((flo.x() - origin_.x()) / cell_)), 0, nx_ - 1);
-    const int ix1 = std::clamp(static_cast<int>(std::floor((fhi.x() - origin_.x()) / cell_)), 0, nx_ - 1);
-    const int iy0 = std::clamp(static_cast<int>(std::floor((flo.y() - origin_.y()) / cell_)), 0, ny_ - 1);
-    const int iy1 = std::clamp(static_cast<int>(std::floor((fhi.y() - origin_.y()) / cell_)), 0, ny_ - 1);
+    // a face that only touches a cell's border is not binned there (1e-9 cell inward)
+    constexpr double kIn = 1e-9;
+    const int ix0 = std::clamp(static_cast<int>(std::floor((flo.x() - origin_.x()) / cell_ + kIn)), 0, nx_ - 1);
+    const int ix1 = std::clamp(static_cast<int>(std::floor((fhi.x() - origin_.x()) / cell_ - kIn)), 0, nx_ - 1);
+    const int iy0 = std::clamp(static_cast<int>(std::floor((flo.y() - origin_.y()) / cell_ + kIn)), 0, ny_ - 1);
+    const int iy1 = std::clamp(static_cast<int>(std::floor((fhi.y() - origin_.y()) / cell_ - kIn)), 0, ny_ - 1);
     for (int iy = iy0; iy <= iy1; ++iy)
       for (int ix = ix0; ix <= ix1; ++ix) {
         bins[CellIndex(ix, iy)].push_back(static_cast<int>(f));
         cell_zmax_[CellIndex(ix, iy)] = std::max(cell_zmax_[CellIndex(ix, iy)], zmax);
       }
   }
+  // cells tiled by coplanar triangles that lie inside them (total area = cell area)
+  cell_planar_.assign(bins.size(), 0);
+  cell_plane_.assign(bins.size(), Eigen::Vector4d::Zero());
+  for (int iy = 0; iy < ny_; ++iy)
+    for (int ix = 0; ix < nx_; ++ix) {
+      const auto& b = bins[CellIndex(ix, iy)];
+      if (b.empty()) continue;
+      const Vector2d clo = origin_ + cell_ * Vector2d(ix, iy), chi = clo + Vector2d(cell_, cell_);
+      const Face& f0 = faces_[b[0]];
+      double area = 0.0;
+      bool ok = true;
+      for (int f : b) {
+        const Face& F = faces_[f];
+        ok = ok && (F.n - f0.n).norm() < 1e-12 && std::abs(F.offset - f0.offset) < 1e-12;
+        const auto& t = mesh_.faces[f];
+        for (int i : t) {
+          const Vector2d q = mesh_.vertices[i].head<2>();
+          ok = ok && (q.array() >= clo.array() - 1e-9).all() && (q.array() <= chi.array() + 1e-9).all();
+        }
+        const Vector3d& p0 = mesh_.vertices[t[0]];
+        area += 0.5 * std::abs(((mesh_.vertices[t[1]] - p0).head<2>().x() * (mesh_.vertices[t[2]] - p0).head<2>().y() -
+                                (mesh_.vertices[t[1]] - p0).head<2>().y() * (mesh_.vertices[t[2]] - p0).head<2>().x()));
+      }
+      if (ok && std::abs(area - cell_ * cell_) < 1e-9 * cell_ * cell_) {
+        cell_planar_[CellIndex(ix, iy)] = 1;
+        cell_plane_[CellIndex(ix, iy)] << f0.n, f0.offset;
+      }
+    }
   cell_start_.resize(bins.size() + 1, 0);
   for (size_t i = 0; i < bins.size(); ++i) cell_start_[i + 1] = cell_start_[i] + static_cast<int>(bins[i].size());
   cell_faces_.reserve(cell_start_.back());
@@ -111,6 +141,23 @@ bool TerrainMesh::Query(const Vector3d& p, Hit* hit) const {
     found = true;
   }
   return found;
+}
+
+bool TerrainMesh::BoxPlane(const Vector2d& lo, const Vector2d& hi, Vector3d* n, double* offset) const {
+  const int ix0 = static_cast<int>(std::floor((lo.x() - origin_.x()) / cell_));
+  const int ix1 = static_cast<int>(std::floor((hi.x() - origin_.x()) / cell_));
+  const int iy0 = static_cast<int>(std::floor((lo.y() - origin_.y()) / cell_));
+  const int iy1 = static_cast<int>(std::floor((hi.y() - origin_.y()) / cell_));
+  if (ix0 < 0 || iy0 < 0 || ix1 >= nx_ || iy1 >= ny_) return false;
+  const Eigen::Vector4d& p0 = cell_plane_[CellIndex(ix0, iy0)];
+  for (int iy = iy0; iy <= iy1; ++iy)
+    for (int ix = ix0; ix <= ix1; ++ix) {
+      const int c = CellIndex(ix, iy);
+      if (!cell_planar_[c] || (cell_plane_[c] - p0).cwiseAbs().maxCoeff() > 1e-12) return false;
+    }
+  *n = p0.head<3>();
+  *offset = p0(3);
+  return true;
 }
 
 double TerrainMesh::MaxHeight(const Vector2d& lo, const Vector2d& hi) const {

@@ -19,7 +19,8 @@ PowertrainParams PowertrainParams::Read(const YamlReader& y) {
   p.brake_max = b.Table("max_torque");
   for (double t : p.brake_max.y())
     if (t < 0) b.Fail("max_torque", detail::Concat("brake torque ", t, " N m must not be negative"));
-  p.brake_speed_eps = b.Positive("speed_eps", 0.05);
+  p.brake_stiffness = b.Positive("stiffness");
+  p.brake_damping = b.NonNegative("damping");
   b.Finish();
   y.Finish();
   return p;
@@ -29,10 +30,16 @@ double PowertrainParams::ClampDriveTorque(double request, double w_ds) const {
   return std::clamp(request, engine_brake(w_ds), wot(w_ds));
 }
 
-double PowertrainParams::BrakeTorque(double effort, double w_rel) const {
+double PowertrainParams::BrakeTorque(double effort, double angle, double w_rel, double* anchor) const {
   effort = std::clamp(effort, 0.0, 1.0);
-  if (effort == 0.0) return 0.0;
-  return -effort * brake_max(std::abs(w_rel)) * std::clamp(w_rel / brake_speed_eps, -1.0, 1.0);
+  const double limit = effort * brake_max(std::abs(w_rel));
+  double t = -brake_stiffness * (angle - *anchor) - brake_damping * w_rel;
+  if (std::abs(t) > limit) {
+    t = std::copysign(limit, t);
+    *anchor = angle + (t + brake_damping * w_rel) / brake_stiffness;  // slide the anchor
+    if (limit == 0.0) *anchor = angle;
+  }
+  return t;
 }
 
 }  // namespace dem_mobility

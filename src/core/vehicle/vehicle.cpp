@@ -185,6 +185,7 @@ std::unique_ptr<Vehicle> Vehicle::Load(const std::string& file, const TerrainMes
   rack_y.Finish();
   v->max_rack_travel_ = st.Positive("max_rack_travel");
   const Penalty actuator = ReadPenalty(st.Child("actuator"));
+  const Penalty spin_lock = ReadPenalty(st.Child("spin_lock"));
   st.Finish();
 
   // ---- chassis
@@ -330,8 +331,8 @@ std::unique_ptr<Vehicle> Vehicle::Load(const std::string& file, const TerrainMes
     ol.name = "rack_prismatic/orientation";
     ol.a = chassis;
     ol.b = rack;
-    ol.k = rot.k;
-    ol.c = rot.c;
+    ol.k = spin_lock.k;
+    ol.c = spin_lock.c;
     sys.orientation_locks.push_back(ol);
     for (int side = 0; side < 2; ++side)
       B.Spherical(std::string("tierod_rack_") + (side == 0 ? "left" : "right"), rack, tierod_body[side], rack_end[side]);
@@ -417,7 +418,9 @@ void Vehicle::ApplyPowertrain(MultibodySystem& sys) {
   d.torque = powertrain_.ClampDriveTorque(drive_request_, d.RelativeSpeed(sys.bodies()));
   for (int i = 0; i < 4; ++i) {
     AxisTorque& b = sys.torques[brakes_[i]];
-    b.torque = powertrain_.BrakeTorque(brake_effort_, b.RelativeSpeed(sys.bodies()));
+    const double w = b.RelativeSpeed(sys.bodies());
+    brake_angle_[i] += w * sys.dt();
+    b.torque = powertrain_.BrakeTorque(brake_effort_, brake_angle_[i], w, &brake_anchor_[i]);
   }
 }
 

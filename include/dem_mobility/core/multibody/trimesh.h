@@ -35,6 +35,9 @@ class TerrainMesh {
   };
   /// Deepest penetrating triangle under point p (x-y projection), if any.
   bool Query(const Eigen::Vector3d& p, Hit* hit) const;
+  /// The plane (unit normal n, offset n.p) under the whole x-y box [lo, hi], if every cell the box
+  /// touches is tiled by triangles of that one plane; lets a caller skip per-triangle tests.
+  bool BoxPlane(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, Eigen::Vector3d* n, double* offset) const;
   /// Highest surface point over the x-y box [lo, hi] (conservative: the cells' maxima).
   double MaxHeight(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const;
 
@@ -58,6 +61,8 @@ class TerrainMesh {
   std::vector<int> cell_start_;  ///< CSR: faces of cell i are cell_faces_[cell_start_[i]..[i+1])
   std::vector<int> cell_faces_;
   std::vector<double> cell_zmax_;
+  std::vector<signed char> cell_planar_;   ///< 1: the cell is tiled by coplanar triangles
+  std::vector<Eigen::Vector4d> cell_plane_;
 };
 
 }  // namespace dem_mobility

@@ -69,6 +69,7 @@ class Vehicle {
   std::array<int, 4> wheels_{};
   std::array<int, 4> uprights_{};
   std::array<int, 4> brakes_{};   ///< indices into system_.torques
+  std::array<double, 4> brake_angle_{}, brake_anchor_{};  ///< wheel angle rel. upright; brake state
   int drive_ = -1;                ///< index into system_.torques
   int steering_ = -1;             ///< index into system_.line_constraints
   double max_rack_travel_ = 0.0;
