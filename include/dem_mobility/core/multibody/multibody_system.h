@@ -67,8 +67,9 @@ class MultibodySystem {
   /// connects (omega^2 = k (1/m_a + 1/m_b), damping factor sqrt(1+z^2)-z); returns the smallest.
   TimeStepLimit CriticalTimeStep() const;
   /// Refuses (ConfigError naming the element and the limit) a dt above the critical step, then
-  /// computes the forces at the initial state.
-  void Finalize(double dt);
+  /// computes the forces at the initial state. `check_step = false` skips the guard (only for
+  /// stability studies such as the integrator tests).
+  void Finalize(double dt, bool check_step = true);
   /// One explicit step. Throws SimulationError on a non-finite state.
   void Step();
 

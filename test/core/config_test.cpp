@@ -1,0 +1,120 @@
+// Bad input gives an error naming the file, the key path and the value.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/vehicle/vehicle.h"
+
+namespace dem_mobility {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A scratch copy of the HMMWV folder in which one file is edited.
+class VehicleCopy {
+ public:
+  VehicleCopy() {
+    dir_ = fs::temp_directory_path() / ("dm_cfg_" + std::to_string(::getpid()) + "_" + std::to_string(counter_++));
+    fs::remove_all(dir_);
+    fs::copy(DM_CONFIG_DIR "/vehicles/hmmwv", dir_, fs::copy_options::recursive);
+  }
+  ~VehicleCopy() { fs::remove_all(dir_); }
+  void Edit(const std::string& file, const std::string& from, const std::string& to) {
+    const fs::path p = dir_ / file;
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::string s = ss.str();
+    const auto pos = s.find(from);
+    ASSERT_NE(pos, std::string::npos) << from;
+    s.replace(pos, from.size(), to);
+    std::ofstream(p) << s;
+  }
+  std::string Error() {
+    try {
+      Vehicle::Load((dir_ / "vehicle.yaml").string(), nullptr, ContactParams(), Eigen::Vector3d::Zero());
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  }
+
+ private:
+  fs::path dir_;
+  static inline int counter_ = 0;
+};
+
+TEST(Config, MissingFile) {
+  try {
+    Vehicle::Load("/nonexistent/vehicle.yaml", nullptr, ContactParams(), Eigen::Vector3d::Zero());
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/vehicle.yaml: cannot open"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Config, TheShippedVehicleLoads) { EXPECT_EQ(VehicleCopy().Error(), ""); }
+
+TEST(Config, UnknownKey) {
+  VehicleCopy c;
+  c.Edit("tire.yaml", "n_lat: 24", "n_lat: 24\nradiuss: 0.5");
+  const std::string e = c.Error();
+  EXPECT_NE(e.find("tire.yaml"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown key(s): radiuss"), std::string::npos) << e;
+}
+
+TEST(Config, MissingKey) {
+  VehicleCopy c;
+  c.Edit("tire.yaml", "width: 0.254", "");
+  const std::string e = c.Error();
+  EXPECT_NE(e.find("tire.yaml: width: missing required key"), std::string::npos) << e;
+}
+
+TEST(Config, NegativeMass) {
+  VehicleCopy c;
+  c.Edit("suspension_front.yaml", "upright: {mass: 19.45", "upright: {mass: -19.45");
+  const std::string e = c.Error();
+  EXPECT_NE(e.find("suspension_front.yaml: masses.upright.mass: value -19.45 must be positive"), std::string::npos) << e;
+}
+
+TEST(Config, NonPositiveDefiniteInertia) {
+  VehicleCopy c;
+  c.Edit("suspension_rear.yaml", "inertia: [0.166, 0.193, 0.044]", "inertia: [0.166, -0.193, 0.044]");
+  const std::string e = c.Error();
+  EXPECT_NE(e.find("suspension_rear.yaml: masses.upright.inertia"), std::string::npos) << e;
+  EXPECT_NE(e.find("-0.193"), std::string::npos) << e;
+}
+
+TEST(Config, MalformedYaml) {
+  VehicleCopy c;
+  c.Edit("driveline.yaml", "final_drive_ratio: 0.2", "final_drive_ratio: [0.2");
+  const std::string e = c.Error();
+  EXPECT_NE(e.find("driveline.yaml: malformed YAML"), std::string::npos) << e;
+}
+
+TEST(Config, WrongTypeNamesTheValue) {
+  VehicleCopy c;
+  c.Edit("driveline.yaml", "final_drive_ratio: 0.2", "final_drive_ratio: fast");
+  const std::string e = c.Error();
+  EXPECT_NE(e.find("driveline.yaml: final_drive_ratio: expected a number, found 'fast'"), std::string::npos) << e;
+}
+
+TEST(Config, RunnerExitsNonZeroWithTheMessage) {
+  const std::string out = (fs::temp_directory_path() / "dm_runner_err.txt").string();
+  const std::string cmd = std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR "/scenes/road_slope.yaml grade_deg=95 2> " + out;
+  const int rc = std::system(cmd.c_str());
+  EXPECT_NE(rc, 0);
+  std::ifstream in(out);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_NE(ss.str().find("road_slope.yaml: grade_deg: value 95 is outside the allowed range"), std::string::npos)
+      << ss.str();
+}
+
+}  // namespace
+}  // namespace dem_mobility

@@ -1,0 +1,104 @@
+// The 33-body vehicle against statics and the power balance on a grade.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/scenes/road_scene.h"
+
+namespace dem_mobility {
+namespace {
+
+RoadSceneParams Scene(double grade) {
+  RoadSceneParams p = RoadSceneParams::Read(YamlReader::Load(DM_CONFIG_DIR "/scenes/road_slope.yaml"));
+  p.grade_deg = grade;
+  return p;
+}
+
+TEST(Vehicle, HasThePapersThirtyThreeBodies) {
+  RoadScene s(Scene(0.0));
+  EXPECT_EQ(s.vehicle().system().num_bodies() - 1, 33);  // minus the ground
+  EXPECT_NEAR(s.vehicle().system().TotalMass(), 4430.0 + 4 * (50.0 + 19.45 + 5.81 + 23.97) + 2 * 6.0 + 4 * 6.0, 1e-9);
+}
+
+TEST(Vehicle, AtRestWheelLoadsCarryTheWeightSplitByTheCom) {
+  RoadScene s(Scene(0.0));
+  Vehicle& v = s.vehicle();
+  MultibodySystem& sys = v.system();
+  v.SetBrakeEffort(1.0);
+  while (sys.time() < 2.0) sys.Step();
+  const double W = sys.TotalMass() * 9.81;
+  double total = 0;
+  for (int i = 0; i < 4; ++i) total += v.WheelLoad(i);
+  EXPECT_NEAR(total, W, 2e-3 * W);
+  // moment balance about the rear axle: front load = W (x_com - x_rear) / (x_front - x_rear)
+  const double xf = 0.5 * (sys.body(v.wheel(0)).x.x() + sys.body(v.wheel(1)).x.x());
+  const double xr = 0.5 * (sys.body(v.wheel(2)).x.x() + sys.body(v.wheel(3)).x.x());
+  const double front = W * (sys.CenterOfMass().x() - xr) / (xf - xr);
+  EXPECT_NEAR(v.WheelLoad(0) + v.WheelLoad(1), front, 5e-3 * W);
+  EXPECT_NEAR(v.WheelLoad(0), v.WheelLoad(1), 2e-3 * W);  // symmetric
+  EXPECT_LT(sys.body(v.chassis()).v.norm(), 1e-3);
+  // ride height: the springs hold the chassis within 2 cm of its design height
+  EXPECT_NEAR(v.ChassisFramePosition().z(), v.design_ride_height(), 0.02);
+}
+
+// Steady speed where WOT(w) G / r = m g (sin th + c_rr cos th), w = v / (G r), on the falling part
+// of the WOT table (bisection), independent of the simulation.
+double PowerBalanceSpeed(const PowertrainParams& pt, double m, double r, double G, double th, double c_rr) {
+  const double torque = m * 9.81 * r * G * (std::sin(th) + c_rr * std::cos(th));
+  double lo = 125.0, hi = 386.0;  // WOT decreases monotonically over [125, 386] rad/s
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (pt.wot(mid) > torque ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi) * G * r;
+}
+
+TEST(Vehicle, SteadySpeedOnAGradeMatchesThePowerBalance) {
+  const double grade = 20.0;
+  RoadSceneParams p = Scene(grade);
+  p.duration = 25.0;
+  RoadScene s(p);
+  const RoadResult r = s.Run();
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  ASSERT_EQ(r.smg.status, "steady");
+  const Vehicle& v = s.vehicle();
+  const double expected = PowerBalanceSpeed(v.powertrain(), v.system().TotalMass(), v.tire().radius,
+                                            v.driveline_reduction(), grade * M_PI / 180.0, p.tire_contact.c_rr);
+  EXPECT_NEAR(r.smg.value, expected, 0.05 * expected);
+  // the plateau is the full-throttle one: the driver asks for more than WOT
+  EXPECT_TRUE(r.history.back().wot_limited);
+}
+
+TEST(Vehicle, AcceleratesAtTheCommandedRateWhileTorqueAllows) {
+  RoadSceneParams p = Scene(0.0);
+  p.duration = 8.0;
+  RoadScene s(p);
+  const RoadResult r = s.Run();
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  // after the controller's start-up, v follows 1 m/s^2: compare the slope over t in [3, 8] s
+  double v3 = 0, v8 = 0;
+  for (const auto& h : r.history) {
+    if (std::abs(h.t - 3.0) < 1e-6 + 0.005) v3 = h.speed;
+    if (std::abs(h.t - 8.0) < 1e-6 + 0.005) v8 = h.speed;
+  }
+  EXPECT_NEAR((v8 - v3) / 5.0, 1.0, 0.03);
+}
+
+TEST(Vehicle, TimeStepAboveTheCriticalOneIsRefused) {
+  RoadSceneParams p = Scene(0.0);
+  RoadScene probe(p);
+  p.time_step = 1.5 * probe.vehicle().system().CriticalTimeStep().dt_crit;
+  try {
+    RoadScene s(p);
+    FAIL() << "a step above the critical one was accepted";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("time_step"), std::string::npos) << m;
+    EXPECT_NE(m.find("critical step"), std::string::npos) << m;
+    EXPECT_NE(m.find("road_slope.yaml"), std::string::npos) << m;
+  }
+}
+
+}  // namespace
+}  // namespace dem_mobility
