@@ -1,0 +1,49 @@
+# Shared helpers of the set-up scripts (sourced, not run).
+set -euo pipefail
+DM_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+DM_BUILD="${DM_BUILD:-$DM_ROOT/build}"
+# Debian's python3 (catkin_pkg, rosbag) before any pyenv/venv python on PATH
+export PATH="/usr/bin:$PATH"
+
+DM_CORE_PACKAGES=(cmake g++ make libeigen3-dev libyaml-cpp-dev libgtest-dev libbenchmark-dev)
+DM_ROS_PACKAGES=(catkin ros-core-dev libroscpp-dev libnodeletlib-dev librosbag-dev libtf2-ros-dev
+  libtf2-eigen-dev ros-geometry-msgs ros-sensor-msgs ros-visualization-msgs ros-message-generation
+  python3-rosbag python3-roslaunch python3-rostest python3-catkin-pkg)
+
+say() { printf '\n==> %s\n' "$*"; }
+
+# Installs the Debian packages that are missing (apt-get update once, only if something is).
+ensure_packages() {
+  local missing=()
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -eq 0 ]; then
+    say "packages: all ${#@} present"
+    return
+  fi
+  local sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  say "packages: installing ${missing[*]}"
+  $sudo apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+}
+
+# Plain CMake build of the ROS-free core, its tests and benchmarks (no catkin).
+build_core() {
+  say "build: core (plain CMake, Release) in $DM_BUILD/core"
+  cmake -S "$DM_ROOT" -B "$DM_BUILD/core" -DDM_BUILD_ROS=OFF -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake --build "$DM_BUILD/core" -j"$(nproc)"
+}
+
+# catkin workspace whose src/ links to this checkout; builds the ROS layer.
+build_catkin() {
+  local ws="$DM_BUILD/ws"
+  say "build: catkin workspace $ws"
+  mkdir -p "$ws/src"
+  touch "$DM_BUILD/CATKIN_IGNORE"  # the workspace sits inside the checkout: do not recurse into it
+  ln -sfn "$DM_ROOT" "$ws/src/dem_mobility"
+  (cd "$ws" && catkin_make -DCMAKE_BUILD_TYPE=Release -DCATKIN_ENABLE_TESTING=ON -j"$(nproc)" >"$DM_BUILD/catkin_make.log" 2>&1) \
+    || { tail -40 "$DM_BUILD/catkin_make.log"; echo "catkin_make failed; full log: $DM_BUILD/catkin_make.log"; exit 1; }
+  tail -3 "$DM_BUILD/catkin_make.log"
+}
