@@ -2,6 +2,9 @@
 set -euo pipefail
 DM_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 DM_BUILD="${DM_BUILD:-$DM_ROOT/build}"
+# the catkin workspace lives outside the checkout (its src/ links back to the checkout; inside it,
+# roslaunch's file search would loop through the link): one per checkout
+DM_WS="${DM_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/dem_mobility/ws-$(printf %s "$DM_ROOT" | md5sum | cut -c1-8)}"
 # Debian's python3 (catkin_pkg, rosbag) before any pyenv/venv python on PATH
 export PATH="/usr/bin:$PATH"
 
@@ -38,10 +41,10 @@ build_core() {
 
 # catkin workspace whose src/ links to this checkout; builds the ROS layer.
 build_catkin() {
-  local ws="$DM_BUILD/ws"
+  local ws="$DM_WS"
   say "build: catkin workspace $ws"
-  mkdir -p "$ws/src"
-  touch "$DM_BUILD/CATKIN_IGNORE"  # the workspace sits inside the checkout: do not recurse into it
+  mkdir -p "$ws/src" "$DM_BUILD"
+  touch "$DM_BUILD/CATKIN_IGNORE"  # catkin must not take build/ for part of the package
   ln -sfn "$DM_ROOT" "$ws/src/dem_mobility"
   (cd "$ws" && catkin_make -DCMAKE_BUILD_TYPE=Release -DCATKIN_ENABLE_TESTING=ON -j"$(nproc)" >"$DM_BUILD/catkin_make.log" 2>&1) \
     || { tail -40 "$DM_BUILD/catkin_make.log"; echo "catkin_make failed; full log: $DM_BUILD/catkin_make.log"; exit 1; }

@@ -3,6 +3,7 @@
 //   dm_run_scene SCENE.yaml [key=value ...] [--out RESULT.yaml] [--history HISTORY.csv] [--quiet]
 //
 // key=value overrides a scene key (dotted for nested keys: driver.kp=4000, grade_deg=12).
+// Arguments of the form __name:=value (added by roslaunch) are ignored.
 #include <cstdio>
 #include <cstring>
 #include <iostream>
@@ -55,6 +56,7 @@ int main(int argc, char** argv) {
     if (a == "--out" && i + 1 < argc) out_file = argv[++i];
     else if (a == "--history" && i + 1 < argc) history_file = argv[++i];
     else if (a == "--quiet") quiet = true;
+    else if (a.rfind("__", 0) == 0 && a.find(":=") != std::string::npos) continue;  // roslaunch's __name:=, __log:=
     else if (a.find('=') != std::string::npos && a.rfind("--", 0) != 0) overrides.push_back(a);
     else return Usage();
   }
