@@ -6,6 +6,8 @@
 // Arguments of the form __name:=value (added by roslaunch) are ignored.
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -74,6 +76,14 @@ int main(int argc, char** argv) {
     if (!root.IsMap()) throw ConfigError(scene_file + ": the top level must be a map of keys");
     for (const auto& o : overrides) ApplyOverride(root, scene_file, o);
     params = RoadSceneParams::Read(YamlReader(root, scene_file, ""));
+    // make sure the results can be written before spending the run on them
+    for (const std::string& f : {out_file, history_file}) {
+      if (f.empty()) continue;
+      const std::filesystem::path parent = std::filesystem::path(f).parent_path();
+      std::error_code ec;
+      if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+      if (!std::ofstream(f, std::ios::app)) throw ConfigError(f + ": cannot write the result file here");
+    }
     scene = std::make_unique<RoadScene>(params);
   } catch (const ConfigError& e) {
     std::cerr << "dm_run_scene: error: " << e.what() << "\n";
