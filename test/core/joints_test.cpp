@@ -75,11 +75,11 @@ TEST(Joints, RevoluteHoldsAgainstAnOffAxisTorqueAndTurnsFreely) {
   EXPECT_NEAR(alpha, 10.0 / (0.2 + m * 0.25), 0.01 * 10.0 / (0.2 + m * 0.25));
 }
 
-TEST(Joints, UniversalResistsTwistOnly) {
-  const double m = 5.0, kr = 1e4, T = 50.0;
-  MultibodySystem s;
+// A 5 kg yoke on a universal joint to the ground at the origin: spherical point plus cross arms
+// ua = x (ground side) and ub = y (yoke) kept perpendicular by a penalty of kr.
+int UniversalYoke(MultibodySystem& s, double kr) {
   s.set_gravity(Vector3d::Zero());
-  const int b = s.AddBody(MakeBody("yoke", m, Vector3d(0.1, 0.1, 0.1), Vector3d(0.3, 0, 0)));
+  const int b = s.AddBody(MakeBody("yoke", 5.0, Vector3d(0.1, 0.1, 0.1), Vector3d(0.3, 0, 0)));
   s.point_joints.push_back(MakePoint(s, 0, b, Vector3d::Zero(), kK, 1e3));
   PerpendicularAxes u;
   u.name = "universal";
@@ -90,6 +90,13 @@ TEST(Joints, UniversalResistsTwistOnly) {
   u.k = kr;
   u.c = 20.0;
   s.perpendicular_axes.push_back(u);
+  return b;
+}
+
+TEST(Joints, UniversalResistsTwistOnly) {
+  const double kr = 1e4, T = 50.0;
+  MultibodySystem s;
+  const int b = UniversalYoke(s, kr);
   // cross arms ua (x, on the ground side) and ub (y, on the yoke): rotation about a x b = z is
   // what a universal joint resists; rotation about either arm is free
   s.mutable_body(b).ext_torque = Vector3d(0, 0, T);
@@ -99,11 +106,7 @@ TEST(Joints, UniversalResistsTwistOnly) {
   EXPECT_LT(s.body(b).w.norm(), 1e-3);
   // free about the arm x (through the COM): alpha = T / I_xx
   MultibodySystem s2;
-  s2.set_gravity(Vector3d::Zero());
-  const int b2 = s2.AddBody(MakeBody("yoke", m, Vector3d(0.1, 0.1, 0.1), Vector3d(0.3, 0, 0)));
-  s2.point_joints.push_back(MakePoint(s2, 0, b2, Vector3d::Zero(), kK, 1e3));
-  u.b = b2;
-  s2.perpendicular_axes.push_back(u);
+  const int b2 = UniversalYoke(s2, kr);
   s2.mutable_body(b2).ext_torque = Vector3d(1.0, 0, 0);
   s2.Finalize(1e-4);
   for (int i = 0; i < 1000; ++i) s2.Step();

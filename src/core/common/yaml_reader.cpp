@@ -178,26 +178,6 @@ YamlReader YamlReader::Child(const std::string& key) const {
   return YamlReader(n, file_, path_.empty() ? key : path_ + "." + key);
 }
 
-bool YamlReader::IsSequence(const std::string& key) const {
-  return node_.IsMap() && node_[key].IsDefined() && node_[key].IsSequence();
-}
-
-std::vector<YamlReader> YamlReader::Sequence(const std::string& key) const {
-  const YAML::Node n = Get(key);
-  if (!n.IsSequence()) Fail(key, "expected a list, found " + Show(n));
-  std::vector<YamlReader> out;
-  for (size_t i = 0; i < n.size(); ++i)
-    out.emplace_back(n[i], file_, (path_.empty() ? key : path_ + "." + key) + "[" + std::to_string(i) + "]");
-  return out;
-}
-
-std::vector<std::string> YamlReader::Keys() const {
-  std::vector<std::string> keys;
-  if (!node_.IsMap()) return keys;
-  for (const auto& kv : node_) keys.push_back(kv.first.as<std::string>());
-  return keys;
-}
-
 std::string YamlReader::ResolvePath(const std::string& relative) const {
   if (!relative.empty() && relative[0] == '/') return relative;
   return Dirname(file_) + "/" + relative;

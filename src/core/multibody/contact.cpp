@@ -170,7 +170,6 @@ void TireContact::Apply(Bodies& bodies, long step) {
   if (history.size() != T.mesh.vertices.size()) history.resize(T.mesh.vertices.size());
   last = ContactSummary();
   applied_step = step;
-  columns_tested = 0;
   const Vector3d u = B.R.col(0), a = B.R.col(1), w = B.R.col(2);
   const double reach = T.radius + 0.5 * T.width;
   const double zmax = terrain->MaxHeight(B.x.head<2>().array() - reach, B.x.head<2>().array() + reach);
@@ -206,7 +205,6 @@ void TireContact::Apply(Bodies& bodies, long step) {
   }
   for (int cc = c_lo; cc <= c_hi; ++cc) {
     const int c = ((cc % T.n_circ) + T.n_circ) % T.n_circ;
-    ++columns_tested;
     for (int j = 0; j < T.n_lat; ++j) {
       const int vi = c * T.n_lat + j;
       const Vector3d r = B.R * T.mesh.vertices[vi];

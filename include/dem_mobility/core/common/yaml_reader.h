@@ -50,10 +50,6 @@ class YamlReader {
   Table1D Table(const std::string& key) const;
 
   YamlReader Child(const std::string& key) const;
-  bool IsSequence(const std::string& key) const;
-  std::vector<YamlReader> Sequence(const std::string& key) const;
-  /// Keys of this map in file order.
-  std::vector<std::string> Keys() const;
 
   /// Resolves a path written in this file relative to the file's folder.
   std::string ResolvePath(const std::string& relative) const;

@@ -89,7 +89,6 @@ struct TireContact {
   std::vector<ContactHistory> history;  ///< one per tire vertex
   ContactSummary last;
   long applied_step = -1;  ///< step of the last Apply
-  int columns_tested = 0;
   void Apply(Bodies& bodies, long step);
   double PotentialEnergy(const Bodies& bodies) const;
   StiffnessInfo Stiffness(const Bodies& bodies) const;

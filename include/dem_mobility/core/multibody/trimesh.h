@@ -43,7 +43,6 @@ class TerrainMesh {
 
   const TriMesh& mesh() const { return mesh_; }
   double max_depth() const { return max_depth_; }
-  size_t num_cells() const { return cell_zmax_.size(); }
 
  private:
   struct Face {
