@@ -1,6 +1,7 @@
-// vehicle_step: wall time of one explicit step of the 33-body vehicle on the rigid road, one
-// thread, with the vehicle driving (tires rolling, driveline loaded). Timed runner: the median of
-// several repetitions, each of many steps.
+// vehicle_step: wall time of one explicit step of the 33-body vehicle on the rigid road (the
+// vehicle's step plus the terrain's tire contact, called in-process), one thread, with the vehicle
+// driving (tires rolling, driveline loaded). Timed runner: the median of several repetitions, each
+// of many steps.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -24,19 +25,21 @@ Figures Measure(double dt) {
   RoadScene scene(p);
   Vehicle& v = scene.vehicle();
   MultibodySystem& sys = v.system();
+  VehicleCoSim& sim = scene.sim();
+  TerrainPort& road = scene.terrain_port();
   // roll at a steady moderate drive torque for 2 s so that the measured steps are typical
   v.SetDriveTorqueRequest(1500.0);
-  while (sys.time() < 2.0) sys.Step();
+  while (sys.time() < 2.0) sim.Step(road);
   const long n = std::max(2000L, static_cast<long>(0.3 / scene.dt()));
   std::vector<double> reps;
   for (int r = 0; r < 7; ++r) {
     const auto t0 = std::chrono::steady_clock::now();
-    for (long i = 0; i < n; ++i) sys.Step();
+    for (long i = 0; i < n; ++i) sim.Step(road);
     reps.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() / n);
   }
   std::sort(reps.begin(), reps.end());
   int contacts = 0;
-  for (int i = 0; i < 4; ++i) contacts += v.TireContactSummary(i).num_contacts;
+  for (int i = 0; i < 4; ++i) contacts += v.wheel_wrench(i).contacts;
   return {reps[reps.size() / 2], scene.dt(), contacts};
 }
 }  // namespace

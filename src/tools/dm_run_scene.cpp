@@ -4,6 +4,8 @@
 //
 // key=value overrides a scene key (dotted for nested keys: driver.kp=4000, grade_deg=12).
 // Arguments of the form __name:=value (added by roslaunch) are ignored.
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -89,18 +91,31 @@ int main(int argc, char** argv) {
     std::cerr << "dm_run_scene: error: " << e.what() << "\n";
     return 1;
   }
-  const auto& lim = scene->vehicle().system().CriticalTimeStep();
+  const TimeStepLimit& lim = scene->sim().limit();
   std::printf("scene %s: grade %.1f deg, %d bodies, dt %.3g s (critical %.3g s, %s), %.1f s simulated\n",
               scene_file.c_str(), params.grade_deg, scene->vehicle().system().num_bodies() - 1, scene->dt(),
               lim.dt_crit, lim.element.c_str(), params.duration);
   std::fflush(stdout);
-  const RoadResult r = scene->Run([quiet](double t, double dur, double v, double wall) {
-    if (quiet) return;
-    const double rtf = t / wall;
-    std::printf("  t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s\n", t, dur, v, rtf,
-                (dur - t) / std::max(rtf, 1e-9));
-    std::fflush(stdout);
-  });
+  // progress on the console about once a second of wall time
+  class Progress final : public CoSimObserver {
+   public:
+    explicit Progress(double duration) : duration_(duration) {}
+    void OnStep(const VehicleCoSim& sim, const DriveCommand&) override {
+      if ((sim.step() & 255) != 0) return;
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+      if (wall < next_) return;
+      next_ += 1.0;
+      const double t = std::max(0.0, sim.driver_time()), rtf = sim.time() / wall;
+      std::printf("  t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s\n", t, duration_,
+                  sim.vehicle().ForwardSpeed(), rtf, (duration_ - t) / std::max(rtf, 1e-9));
+      std::fflush(stdout);
+    }
+
+   private:
+    double duration_, next_ = 1.0;
+    std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+  } progress(params.duration);
+  const RoadResult r = scene->Run(quiet ? nullptr : &progress);
   try {
     if (!out_file.empty()) WriteRoadResult(r, params, out_file);
     if (!history_file.empty()) WriteRoadHistory(r, history_file);

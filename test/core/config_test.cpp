@@ -37,7 +37,7 @@ class VehicleCopy {
   }
   std::string Error() {
     try {
-      Vehicle::Load((dir_ / "vehicle.yaml").string(), nullptr, ContactParams(), Eigen::Vector3d::Zero());
+      Vehicle::Load((dir_ / "vehicle.yaml").string(), Eigen::Vector3d::Zero());
     } catch (const ConfigError& e) {
       return e.what();
     }
@@ -51,7 +51,7 @@ class VehicleCopy {
 
 TEST(Config, MissingFile) {
   try {
-    Vehicle::Load("/nonexistent/vehicle.yaml", nullptr, ContactParams(), Eigen::Vector3d::Zero());
+    Vehicle::Load("/nonexistent/vehicle.yaml", Eigen::Vector3d::Zero());
     FAIL();
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/vehicle.yaml: cannot open"), std::string::npos) << e.what();

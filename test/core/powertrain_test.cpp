@@ -49,13 +49,13 @@ TEST(Driver, RequestsWotWhenTheCommandOutrunsTheVehicle) {
   EXPECT_DOUBLE_EQ(drv.SpeedCommand(10.0), 10.0);
   EXPECT_DOUBLE_EQ(drv.SpeedCommand(40.0), 25.0);
   // far behind the command at 125 rad/s: the request exceeds WOT, clamp to the table
-  const DriverCommand c = drv.Update(20.0, 1e-3, 5.0, 125.0);
+  const DriveCommand c = drv.Update(20.0, 1e-3, 5.0, 125.0);
   EXPECT_TRUE(c.wot_limited);
   EXPECT_DOUBLE_EQ(c.drive_torque, 1885.0);
   EXPECT_EQ(c.brake_effort, 0.0);
   // far ahead of the command: below the engine brake, the brakes take the rest
   SpeedDriver drv2(d, p, 4863.0, 0.485, 0.2);
-  const DriverCommand b = drv2.Update(5.0, 1e-3, 15.0, 150.0);
+  const DriveCommand b = drv2.Update(5.0, 1e-3, 15.0, 150.0);
   EXPECT_DOUBLE_EQ(b.drive_torque, -29.0);
   EXPECT_GT(b.brake_effort, 0.0);
 }

@@ -26,7 +26,7 @@ TEST(Vehicle, AtRestWheelLoadsCarryTheWeightSplitByTheCom) {
   Vehicle& v = s.vehicle();
   MultibodySystem& sys = v.system();
   v.SetBrakeEffort(1.0);
-  while (sys.time() < 2.0) sys.Step();
+  while (sys.time() < 2.0) s.sim().Step(s.terrain_port());
   const double W = sys.TotalMass() * 9.81;
   double total = 0;
   for (int i = 0; i < 4; ++i) total += v.WheelLoad(i);
@@ -63,8 +63,9 @@ TEST(Vehicle, SteadySpeedOnAGradeMatchesThePowerBalance) {
   ASSERT_TRUE(r.error.empty()) << r.error;
   ASSERT_EQ(r.smg.status, "steady");
   const Vehicle& v = s.vehicle();
+  const double c_rr = YamlReader::Load(p.terrain_file).Child("contact").Double("c_rr");
   const double expected = PowerBalanceSpeed(v.powertrain(), v.system().TotalMass(), v.tire().radius,
-                                            v.driveline_reduction(), grade * M_PI / 180.0, p.tire_contact.c_rr);
+                                            v.driveline_reduction(), grade * M_PI / 180.0, c_rr);
   EXPECT_NEAR(r.smg.value, expected, 0.05 * expected);
   // the plateau is the full-throttle one: the driver asks for more than WOT
   EXPECT_TRUE(r.history.back().wot_limited);
@@ -88,7 +89,7 @@ TEST(Vehicle, AcceleratesAtTheCommandedRateWhileTorqueAllows) {
 TEST(Vehicle, TimeStepAboveTheCriticalOneIsRefused) {
   RoadSceneParams p = Scene(0.0);
   RoadScene probe(p);
-  p.time_step = 1.5 * probe.vehicle().system().CriticalTimeStep().dt_crit;
+  p.time_step = 1.5 * probe.sim().limit().dt_crit;
   try {
     RoadScene s(p);
     FAIL() << "a step above the critical one was accepted";

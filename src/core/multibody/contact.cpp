@@ -240,12 +240,15 @@ double TireContact::PotentialEnergy(const Bodies& bodies) const {
       e += ContactPointEnergy(params, *terrain, B.PointWorld(tire->mesh.vertices[i]), history[i], applied_step);
   return e;
 }
-StiffnessInfo TireContact::Stiffness(const Bodies& bodies) const {
+int TireContact::SimultaneousVertices() const {
   // vertices that can be in contact at once: the columns within the terrain's max_depth
-  const RigidBody& B = bodies[body];
   const double half = std::acos(std::max(-1.0, 1.0 - terrain->max_depth() / tire->radius));
   const int cols = 1 + 2 * static_cast<int>(std::ceil(half / (2.0 * M_PI / tire->n_circ)));
-  const int n = std::min(tire->n_circ, cols) * tire->n_lat;
+  return std::min(tire->n_circ, cols) * tire->n_lat;
+}
+StiffnessInfo TireContact::Stiffness(const Bodies& bodies) const {
+  const RigidBody& B = bodies[body];
+  const int n = SimultaneousVertices();
   const double k = std::max(params.k_n, params.k_t);
   const double w2 = n * k * InverseEffectiveMass(B, Vector3d(0, 0, tire->radius));
   StiffnessInfo s;

@@ -71,7 +71,6 @@ TimeStepLimit MultibodySystem::CriticalTimeStep() const {
   for (const auto& e : cv_twists) consider("joint", e.name, e.Stiffness(bodies_));
   for (const auto& e : springs) consider("spring", e.name, e.Stiffness(bodies_));
   for (const auto& e : point_contacts) consider("contact", e.name, e.Stiffness(bodies_));
-  for (const auto& e : tire_contacts) consider("contact", e.name, e.Stiffness(bodies_));
   return lim;
 }
 
@@ -82,8 +81,6 @@ void MultibodySystem::Finalize(double dt, bool check_step) {
                   " s of ", lim.element, " (", lim.detail, "); use dt <= ", lim.dt_crit,
                   " s or soften that element");
   for (const auto& c : point_contacts) DM_THROW_UNLESS(c.terrain != nullptr, "contact '", c.name, "' has no terrain");
-  for (const auto& c : tire_contacts)
-    DM_THROW_UNLESS(c.terrain != nullptr && c.tire != nullptr, "tire contact '", c.name, "' has no terrain or tire");
   dt_ = dt;
   finalized_ = true;
   ComputeForces();
@@ -105,7 +102,6 @@ void MultibodySystem::ComputeForces() {
   for (const auto& e : springs) e.Apply(bodies_);
   for (const auto& e : torques) e.Apply(bodies_);
   for (auto& e : point_contacts) e.Apply(bodies_, step_);
-  for (auto& e : tire_contacts) e.Apply(bodies_, step_);
   for (RigidBody& b : bodies_) {
     if (b.fixed) continue;
     b.accel = b.inv_mass * b.force;
@@ -115,6 +111,11 @@ void MultibodySystem::ComputeForces() {
 }
 
 void MultibodySystem::Step() {
+  BeginStep();
+  EndStep();
+}
+
+void MultibodySystem::BeginStep() {
   DM_DEMAND(finalized_);
   const double dt = dt_, h = 0.5 * dt_;
   for (RigidBody& b : bodies_) {
@@ -130,6 +131,10 @@ void MultibodySystem::Step() {
     for (RigidBody& b : bodies_) Reorthonormalize(b.R);
   time_ += dt;
   ++step_;
+}
+
+void MultibodySystem::EndStep() {
+  const double h = 0.5 * dt_;
   ComputeForces();
   for (RigidBody& b : bodies_) {
     if (b.fixed) continue;
@@ -172,7 +177,6 @@ EnergyReport MultibodySystem::Energy() const {
   for (const auto& x : cv_twists) e.elastic += x.PotentialEnergy(bodies_);
   for (const auto& x : springs) e.elastic += x.PotentialEnergy(bodies_);
   for (const auto& x : point_contacts) e.elastic += x.PotentialEnergy(bodies_);
-  for (const auto& x : tire_contacts) e.elastic += x.PotentialEnergy(bodies_);
   return e;
 }
 

@@ -16,20 +16,15 @@ RoadSceneParams RoadSceneParams::Read(const YamlReader& y) {
   const std::string scene = y.String("scene");
   if (scene != "road_slope") y.Fail("scene", "expected 'road_slope', found '" + scene + "'");
   p.vehicle_file = y.ResolvePath(y.String("vehicle"));
+  p.terrain_file = y.ResolvePath(y.String("terrain"));
   p.grade_deg = y.DoubleIn("grade_deg", -45.0, 45.0);
   p.duration = y.DoubleIn("duration", 1e-3, 3600.0);
   p.settle_time = y.DoubleIn("settle_time", 0.0, 10.0, 0.5);
   if (y.Has("time_step") && y.String("time_step") != "auto") p.time_step = y.DoubleIn("time_step", 1e-7, 1e-2);
   p.time_step_safety = y.DoubleIn("time_step_safety", 0.01, 1.0, 0.5);
-  const YamlReader road = y.Child("road");
-  p.road_length = road.Positive("length");
-  p.road_width = road.DoubleIn("width", 3.0, 1000.0);
-  p.road_cell = road.Positive("cell");
-  p.road_start = road.Double("start_x");
-  road.Finish();
-  const YamlReader tc = y.Child("tire_contact");
-  p.tire_contact = ContactParams::Read(tc);
-  tc.Finish();
+  p.coupling_interval = y.Int("coupling_interval", 1);
+  if (p.coupling_interval < 1 || p.coupling_interval > 1000)
+    y.Fail("coupling_interval", "must be a whole number of steps in [1, 1000], found " + std::to_string(p.coupling_interval));
   p.driver = DriverParams::Read(y.Child("driver"));
   const YamlReader res = y.Child("result");
   p.sample_rate = res.DoubleIn("sample_rate", 1.0, 1e5, 100.0);
@@ -42,28 +37,102 @@ RoadSceneParams RoadSceneParams::Read(const YamlReader& y) {
   return p;
 }
 
-Eigen::Vector3d RoadScene::GradeGravity(double deg) {
+Eigen::Vector3d VehicleCoSim::GradeGravity(double deg) {
   const double a = deg * M_PI / 180.0;
   return 9.81 * Eigen::Vector3d(-std::sin(a), 0.0, -std::cos(a));
 }
 
-RoadScene::RoadScene(const RoadSceneParams& p) : p_(p) {
-  terrain_ = std::make_unique<TerrainMesh>(MakeFlatRoad(p.road_start, p.road_length, p.road_width, p.road_cell),
-                                           p.road_cell, 0.05);
-  vehicle_ = Vehicle::Load(p.vehicle_file, terrain_.get(), p.tire_contact, Eigen::Vector3d::Zero());
-  // place the chassis frame so that the tires just touch the road at the start
-  const Eigen::Vector3d shift(p.road_start + 10.0, 0.0, vehicle_->design_ride_height());
+VehicleCoSim::VehicleCoSim(const RoadSceneParams& p) : p_(p) {
+  // the chassis frame at x = 0 with the tires just touching the plane z = 0
+  vehicle_ = Vehicle::Load(p.vehicle_file, Eigen::Vector3d::Zero());
   MultibodySystem& sys = vehicle_->system();
+  const Eigen::Vector3d shift(0.0, 0.0, vehicle_->design_ride_height());
   for (int i = 1; i < sys.num_bodies(); ++i) sys.mutable_body(i).x += shift;
   sys.set_gravity(GradeGravity(p.grade_deg));
-  limit_ = sys.CriticalTimeStep();
-  dt_ = p.time_step > 0.0 ? p.time_step : p.time_step_safety * limit_.dt_crit;
-  try {
-    sys.Finalize(dt_);
-  } catch (const ConfigError& e) {
-    throw ConfigError(p.file + ": time_step: " + e.what());
+  states_.resize(4);
+  wrenches_.resize(4);
+}
+
+void VehicleCoSim::Exchange(TerrainPort& terrain) {
+  for (int i = 0; i < 4; ++i) states_[i] = vehicle_->GetWheelState(i);
+  terrain.Exchange(step(), time(), dt_, states_, &wrenches_);
+  DM_THROW_UNLESS(wrenches_.size() == 4, "the terrain answered step ", step(), " with ", wrenches_.size(),
+                  " wrenches for 4 wheels");
+  for (int i = 0; i < 4; ++i) {
+    const WheelWrench& w = wrenches_[i];
+    if (!(w.force.allFinite() && w.moment.allFinite()))
+      throw SimulationError(detail::Concat("step ", step(), " (t = ", time(), " s): the terrain's wrench on wheel ", i,
+                                           " is not finite (force ", w.force.transpose(), ")"));
+    vehicle_->SetWheelWrench(i, w);
+  }
+  ++exchanges_;
+  last_exchange_ = step();
+  // the contact the terrain reports must stay within the explicit limit of the step in use
+  const WheelWrench& w0 = wrenches_[0];
+  if (dt_ > 0.0 && (w0.stiffness != checked_stiffness_ || w0.damping != checked_damping_)) {
+    const TimeStepLimit c = vehicle_->WheelContactLimit(w0.stiffness, w0.damping);
+    if (dt_ > c.dt_crit)
+      throw SimulationError(detail::Concat("step ", step(), " (t = ", time(), " s): time step ", dt_,
+                                           " s is above the critical step ", c.dt_crit, " s of ", c.element, " (",
+                                           c.detail, ")"));
+    checked_stiffness_ = w0.stiffness;
+    checked_damping_ = w0.damping;
   }
 }
+
+void VehicleCoSim::Start(TerrainPort& terrain) {
+  DM_DEMAND(dt_ == 0.0);
+  Exchange(terrain);
+  MultibodySystem& sys = vehicle_->system();
+  limit_ = sys.CriticalTimeStep();
+  const TimeStepLimit contact = vehicle_->WheelContactLimit(wrenches_[0].stiffness, wrenches_[0].damping);
+  if (contact.dt_crit < limit_.dt_crit) limit_ = contact;
+  const double dt = p_.time_step > 0.0 ? p_.time_step : p_.time_step_safety * limit_.dt_crit;
+  if (!(dt <= limit_.dt_crit))
+    throw ConfigError(detail::Concat(p_.file, ": time_step: time step dt = ", dt, " s is above the critical step ",
+                                     limit_.dt_crit, " s of ", limit_.element, " (", limit_.detail, "); use dt <= ",
+                                     limit_.dt_crit, " s or soften that element"));
+  try {
+    sys.Finalize(dt);
+  } catch (const ConfigError& e) {
+    throw ConfigError(p_.file + ": time_step: " + e.what());
+  }
+  dt_ = dt;
+  checked_stiffness_ = wrenches_[0].stiffness;
+  checked_damping_ = wrenches_[0].damping;
+  settle_steps_ = std::lround(p_.settle_time / dt_);
+}
+
+void VehicleCoSim::Step(TerrainPort& terrain) {
+  MultibodySystem& sys = vehicle_->system();
+  sys.BeginStep();
+  if (sys.step_count() % p_.coupling_interval == 0) Exchange(terrain);
+  sys.EndStep();
+}
+
+void LocalTerrainPort::Exchange(long step, double t, double /*dt*/, const std::vector<WheelState>& states,
+                                std::vector<WheelWrench>* wrenches) {
+  model_.Compute(step, t, states, wrenches);
+}
+
+SceneDriver::SceneDriver(const DriverParams& p, const std::string& vehicle_file)
+    : vehicle_(Vehicle::Load(vehicle_file, Eigen::Vector3d::Zero())),
+      driver_(p, vehicle_->powertrain(), vehicle_->system().TotalMass(), vehicle_->tire().radius,
+              vehicle_->driveline_reduction()) {}
+
+DriveCommand SceneDriver::Exchange(const DriveInput& in) {
+  return driver_.Update(in.time, in.period, in.forward_speed, in.drive_shaft_speed);
+}
+
+RoadScene::RoadScene(const RoadSceneParams& p)
+    : terrain_(LoadTerrainModel(p.terrain_file, p.vehicle_file)),
+      port_(*terrain_),
+      driver_(p.driver, p.vehicle_file),
+      sim_(p) {
+  sim_.Start(port_);
+}
+
+RoadResult RoadScene::Run(CoSimObserver* observer) { return RunCoSimulation(sim_, port_, driver_, observer); }
 
 SpeedMadeGood DetectSpeedMadeGood(const std::vector<RoadSample>& h, const PlateauParams& p, double v_max) {
   SpeedMadeGood s;
@@ -105,56 +174,70 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<RoadSample>& h, const Platea
   return s;
 }
 
-RoadResult RoadScene::Run(const ProgressFn& progress) {
+RoadResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, DriverPort& driver, CoSimObserver* observer) {
+  const RoadSceneParams& p = sim.params();
   RoadResult r;
-  r.dt = dt_;
-  r.dt_crit = limit_.dt_crit;
-  r.dt_limit_element = limit_.element;
-  MultibodySystem& sys = vehicle_->system();
-  Vehicle& veh = *vehicle_;
-  SpeedDriver driver(p_.driver, veh.powertrain(), sys.TotalMass(), veh.tire().radius, veh.driveline_reduction());
+  r.dt = sim.dt();
+  r.dt_crit = sim.limit().dt_crit;
+  r.dt_limit_element = sim.limit().element;
+  Vehicle& veh = sim.vehicle();
+  const double dt = sim.dt();
   const auto wall0 = std::chrono::steady_clock::now();
-  auto wall = [&wall0] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  };
-  const long settle_steps = std::lround(p_.settle_time / dt_);
-  const long run_steps = std::lround(p_.duration / dt_);
-  const long sample_every = std::max(1L, std::lround(1.0 / (p_.sample_rate * dt_)));
-  double next_progress = 1.0;
+  const long drive_step = sim.settle_steps();
+  const long run_steps = std::lround(p.duration / dt);
+  const long sample_every = std::max(1L, std::lround(1.0 / (p.sample_rate * dt)));
+  const long control_every = std::max(1L, std::lround(p.driver.control_period / dt));
+  DriveCommand cmd;
+  cmd.brake_effort = 1.0;  // settling: brakes on, no drive
+  double x0 = 0.0;
   try {
-    veh.SetBrakeEffort(1.0);
+    veh.SetBrakeEffort(cmd.brake_effort);
     veh.SetDriveTorqueRequest(0.0);
-    for (long i = 0; i < settle_steps; ++i) sys.Step();
-    const double x0 = veh.ChassisFramePosition().x();
-    for (long i = 0; i <= run_steps; ++i) {
-      const double t = i * dt_;
-      const double v = veh.ForwardSpeed();
-      const double w_ds = veh.DriveShaftSpeed();
-      const DriverCommand cmd = driver.Update(t, dt_, v, w_ds);
-      veh.SetDriveTorqueRequest(cmd.drive_torque);
-      veh.SetBrakeEffort(cmd.brake_effort);
-      if (i % sample_every == 0) {
-        r.history.push_back({t, veh.ChassisFramePosition().x() - x0, v, cmd.speed_command, w_ds,
-                             veh.AppliedDriveTorque(), cmd.brake_effort, cmd.wot_limited});
-        if (t >= p_.plateau.stall_time && v < p_.plateau.stall_speed && cmd.speed_command > p_.plateau.stall_speed) {
-          r.ended_early = true;
-          break;
+    if (observer) observer->OnStep(sim, cmd);
+    for (;;) {
+      const long k = sim.step() - drive_step;  // steps since the driver's start
+      if (k >= 0) {
+        if (k == 0) x0 = veh.ChassisFramePosition().x();
+        const double t = k * dt;
+        const double v = veh.ForwardSpeed();
+        const double w_ds = veh.DriveShaftSpeed();
+        if (k % control_every == 0) {
+          DriveInput in;
+          in.step = sim.step();
+          in.time = t;
+          in.period = control_every * dt;
+          in.forward_speed = v;
+          in.drive_shaft_speed = w_ds;
+          cmd = driver.Exchange(in);
+          ++r.driver_updates;
+          veh.SetDriveTorqueRequest(cmd.drive_torque);
+          veh.SetBrakeEffort(cmd.brake_effort);
         }
+        if (k % sample_every == 0) {
+          r.history.push_back({t, veh.ChassisFramePosition().x() - x0, v, cmd.speed_command, w_ds,
+                               veh.AppliedDriveTorque(), cmd.brake_effort, cmd.wot_limited});
+          if (t >= p.plateau.stall_time && v < p.plateau.stall_speed && cmd.speed_command > p.plateau.stall_speed) {
+            r.ended_early = true;
+            break;
+          }
+        }
+        if (k >= run_steps) break;
       }
-      if (i == run_steps) break;
-      sys.Step();
-      if (progress && wall() >= next_progress) {
-        progress(t, p_.duration, v, wall());
-        next_progress += 1.0;
+      if (observer && observer->StopRequested()) {
+        r.interrupted = true;
+        break;
       }
+      sim.Step(terrain);
+      if (observer) observer->OnStep(sim, cmd);
     }
   } catch (const SimulationError& e) {
     r.error = e.what();
   }
-  r.steps = sys.step_count();
+  r.steps = sim.step();
+  r.exchanges = sim.exchanges();
   r.sim_time = r.history.empty() ? 0.0 : r.history.back().t;
-  r.wall_time = wall();
-  r.smg = DetectSpeedMadeGood(r.history, p_.plateau, p_.driver.v_max);
+  r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  r.smg = DetectSpeedMadeGood(r.history, p.plateau, p.driver.v_max);
   return r;
 }
 
@@ -172,10 +255,14 @@ void WriteRoadResult(const RoadResult& r, const RoadSceneParams& p, const std::s
   e << YAML::Key << "time_step" << YAML::Value << r.dt;
   e << YAML::Key << "critical_time_step" << YAML::Value << r.dt_crit;
   e << YAML::Key << "critical_element" << YAML::Value << r.dt_limit_element;
+  e << YAML::Key << "coupling_interval" << YAML::Value << p.coupling_interval;
   e << YAML::Key << "steps" << YAML::Value << r.steps;
+  e << YAML::Key << "exchanges" << YAML::Value << r.exchanges;
+  e << YAML::Key << "driver_updates" << YAML::Value << r.driver_updates;
   e << YAML::Key << "simulated_time" << YAML::Value << r.sim_time;
   e << YAML::Key << "wall_time" << YAML::Value << r.wall_time;
   e << YAML::Key << "real_time_factor" << YAML::Value << (r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0);
+  e << YAML::Key << "interrupted" << YAML::Value << r.interrupted;
   e << YAML::Key << "error" << YAML::Value << r.error;
   e << YAML::EndMap;
   std::ofstream out(path);

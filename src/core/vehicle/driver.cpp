@@ -15,6 +15,7 @@ DriverParams DriverParams::Read(const YamlReader& y) {
   p.kp = y.NonNegative("kp");
   p.ki = y.NonNegative("ki");
   p.full_throttle = y.Bool("full_throttle", false);
+  p.control_period = y.DoubleIn("control_period", 1e-7, 0.1, 1e-3);
   y.Finish();
   return p;
 }
@@ -25,8 +26,8 @@ SpeedDriver::SpeedDriver(const DriverParams& p, const PowertrainParams& pt, doub
 
 double SpeedDriver::SpeedCommand(double t) const { return std::min(p_.v_max, p_.accel * std::max(0.0, t)); }
 
-DriverCommand SpeedDriver::Update(double t, double dt, double v, double w_ds) {
-  DriverCommand c;
+DriveCommand SpeedDriver::Update(double t, double dt, double v, double w_ds) {
+  DriveCommand c;
   const double wot = pt_.wot(w_ds), eb = pt_.engine_brake(w_ds);
   if (p_.full_throttle) {
     c.speed_command = std::numeric_limits<double>::infinity();

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "dem_mobility/core/common/error.h"
@@ -126,10 +127,21 @@ class Builder {
 
 const char* kCorner[4] = {"fl", "fr", "rl", "rr"};
 
+TireGeometry ReadTire(const YamlReader& ty) {
+  TireGeometry t = TireGeometry::Make(ty.Positive("radius"), ty.Positive("width"), ty.NonNegative("shoulder_radius"),
+                                      ty.Int("n_circ"), ty.Int("n_lat"));
+  ty.Finish();
+  return t;
+}
+
 }  // namespace
 
-std::unique_ptr<Vehicle> Vehicle::Load(const std::string& file, const TerrainMesh* terrain,
-                                       const ContactParams& tire_contact, const Vector3d& position) {
+TireGeometry LoadTireGeometry(const std::string& file) {
+  const YamlReader top = YamlReader::Load(file);
+  return ReadTire(YamlReader::Load(top.ResolvePath(top.String("tire"))));
+}
+
+std::unique_ptr<Vehicle> Vehicle::Load(const std::string& file, const Vector3d& position) {
   std::unique_ptr<Vehicle> v(new Vehicle());
   MultibodySystem& sys = v->system_;
   const YamlReader top = YamlReader::Load(file);
@@ -147,9 +159,7 @@ std::unique_ptr<Vehicle> Vehicle::Load(const std::string& file, const TerrainMes
   const YamlReader pt = YamlReader::Load(top.ResolvePath(top.String("powertrain")));
   const YamlReader ty = YamlReader::Load(top.ResolvePath(top.String("tire")));
   v->powertrain_ = PowertrainParams::Read(pt);
-  v->tire_ = TireGeometry::Make(ty.Positive("radius"), ty.Positive("width"), ty.NonNegative("shoulder_radius"),
-                                ty.Int("n_circ"), ty.Int("n_lat"));
-  ty.Finish();
+  v->tire_ = ReadTire(ty);
 
   Builder B(&sys, position, point, rot);
 
@@ -397,17 +407,6 @@ std::unique_ptr<Vehicle> Vehicle::Load(const std::string& file, const TerrainMes
 
   // ---- tires
   v->ride_height_ = v->tire_.radius - spindle_z;
-  if (terrain != nullptr) {
-    for (int i = 0; i < 4; ++i) {
-      TireContact tc;
-      tc.name = std::string("tire_") + kCorner[i];
-      tc.body = v->wheels_[i];
-      tc.tire = &v->tire_;
-      tc.params = tire_contact;
-      tc.terrain = terrain;
-      sys.tire_contacts.push_back(tc);
-    }
-  }
   Vehicle* self = v.get();
   sys.pre_force_hook = [self](MultibodySystem& s) { self->ApplyPowertrain(s); };
   return v;
@@ -439,7 +438,41 @@ double Vehicle::ForwardSpeed() const {
 double Vehicle::DriveShaftSpeed() const { return system_.torques[drive_].RelativeSpeed(system_.bodies()); }
 double Vehicle::WheelSpeed(int i) const { return system_.torques[brakes_[i]].RelativeSpeed(system_.bodies()); }
 double Vehicle::AppliedDriveTorque() const { return system_.torques[drive_].torque; }
-const ContactSummary& Vehicle::TireContactSummary(int i) const { return system_.tire_contacts[i].last; }
-double Vehicle::WheelLoad(int i) const { return system_.tire_contacts[i].last.normal_force; }
+
+WheelState Vehicle::GetWheelState(int i) const {
+  const RigidBody& b = system_.body(wheels_[i]);
+  WheelState s;
+  s.position = b.x;
+  s.orientation = Eigen::Quaterniond(b.R);
+  s.velocity = b.v;
+  s.angular_velocity = b.R * b.w;
+  return s;
+}
+
+void Vehicle::SetWheelWrench(int i, const WheelWrench& w) {
+  wrench_[i] = w;
+  RigidBody& b = system_.mutable_body(wheels_[i]);
+  b.ext_force = w.force;
+  b.ext_torque = w.moment;
+}
+
+TimeStepLimit Vehicle::WheelContactLimit(double stiffness, double damping) const {
+  TimeStepLimit lim;
+  lim.dt_crit = std::numeric_limits<double>::infinity();
+  if (stiffness <= 0.0) return lim;
+  for (int i = 0; i < 4; ++i) {
+    const RigidBody& b = system_.body(wheels_[i]);
+    const double w2 = stiffness * InverseEffectiveMass(b, Vector3d(0, 0, tire_.radius));
+    const double zeta = damping * std::sqrt(w2) / (2.0 * stiffness);
+    const double dt = CriticalStep(std::sqrt(w2), zeta);
+    if (dt < lim.dt_crit) {
+      lim.dt_crit = dt;
+      lim.element = std::string("wheel-terrain contact 'tire_") + kCorner[i] + "'";
+      lim.detail = detail::Concat("terrain contact stiffness ", stiffness, " N/m, damping ", damping, " N s/m on '",
+                                  b.name, "' ", b.mass, " kg");
+    }
+  }
+  return lim;
+}
 
 }  // namespace dem_mobility

@@ -92,6 +92,8 @@ struct TireContact {
   void Apply(Bodies& bodies, long step);
   double PotentialEnergy(const Bodies& bodies) const;
   StiffnessInfo Stiffness(const Bodies& bodies) const;
+  /// How many tire vertices can touch the terrain at once (the columns within its max_depth).
+  int SimultaneousVertices() const;
 };
 
 }  // namespace dem_mobility

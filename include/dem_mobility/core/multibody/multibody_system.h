@@ -57,7 +57,6 @@ class MultibodySystem {
   std::vector<SpringDamper> springs;
   std::vector<AxisTorque> torques;
   std::vector<PointSetContact> point_contacts;
-  std::vector<TireContact> tire_contacts;
 
   /// Called after the element forces and before the accelerations, every force evaluation
   /// (for controllers that set AxisTorque values from the current state).
@@ -70,8 +69,14 @@ class MultibodySystem {
   /// computes the forces at the initial state. `check_step = false` skips the guard (only for
   /// stability studies such as the integrator tests).
   void Finalize(double dt, bool check_step = true);
-  /// One explicit step. Throws SimulationError on a non-finite state.
+  /// One explicit step (BeginStep then EndStep). Throws SimulationError on a non-finite state.
   void Step();
+  /// The first half of a step: half kick with the current forces, drift to t + dt. Between the two
+  /// halves the positions and half-step velocities are those the new forces are evaluated at, so a
+  /// co-simulation peer (the terrain) computes its wrenches from them and sets ext_force/ext_torque.
+  void BeginStep();
+  /// The second half: forces at the new state, second half kick, finiteness check.
+  void EndStep();
 
   double time() const { return time_; }
   long step_count() const { return step_; }

@@ -15,11 +15,12 @@ struct DriverParams {
   double kp = 0.0;            ///< speed feedback [N per m/s]
   double ki = 0.0;            ///< integral feedback [N per m]
   bool full_throttle = false; ///< ignore the profile: request WOT all the time
+  double control_period = 1e-3; ///< [s] the driver acts this often (rounded to whole vehicle steps)
   static DriverParams Read(const YamlReader& y);
 };
 
 /// Command produced each step.
-struct DriverCommand {
+struct DriveCommand {
   double speed_command = 0.0;   ///< [m/s]
   double torque_request = 0.0;  ///< drive-shaft torque asked for [N m] (before the engine clamp)
   double drive_torque = 0.0;    ///< after the clamp between engine-brake and WOT curves [N m]
@@ -36,7 +37,7 @@ class SpeedDriver {
   /// Speed command of the profile at time t (from the driver's start).
   double SpeedCommand(double t) const;
   /// Advances the controller by dt at time t with forward speed v and drive-shaft speed w_ds.
-  DriverCommand Update(double t, double dt, double v, double w_ds);
+  DriveCommand Update(double t, double dt, double v, double w_ds);
 
  private:
   DriverParams p_;

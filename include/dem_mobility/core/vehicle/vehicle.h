@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "dem_mobility/core/cosim/exchange.h"
 #include "dem_mobility/core/multibody/multibody_system.h"
 #include "dem_mobility/core/vehicle/powertrain.h"
 
@@ -23,11 +24,10 @@ enum WheelIndex { kFrontLeft = 0, kFrontRight = 1, kRearLeft = 2, kRearRight = 3
 /// turns the brake effort into wheel torques at the current wheel speeds.
 class Vehicle {
  public:
-  /// Builds the vehicle described by `file` with its chassis reference frame at `position` (world),
-  /// wheels in contact with `terrain` (may be null: no tire contact) using `tire_contact`.
+  /// Builds the vehicle described by `file` with its chassis reference frame at `position` (world).
+  /// The wheels touch nothing: the terrain's wrenches arrive through SetWheelWrench.
   /// Throws ConfigError naming the file and key of any bad or unknown input.
-  static std::unique_ptr<Vehicle> Load(const std::string& file, const TerrainMesh* terrain,
-                                       const ContactParams& tire_contact, const Eigen::Vector3d& position);
+  static std::unique_ptr<Vehicle> Load(const std::string& file, const Eigen::Vector3d& position);
 
   MultibodySystem& system() { return system_; }
   const MultibodySystem& system() const { return system_; }
@@ -47,8 +47,15 @@ class Vehicle {
   double ForwardSpeed() const;       ///< chassis COM velocity along the chassis x axis [m/s]
   double DriveShaftSpeed() const;    ///< relative to the chassis [rad/s]
   double WheelSpeed(int i) const;    ///< spin relative to the upright [rad/s]
-  double WheelLoad(int i) const;     ///< normal contact force on the tire, last evaluation [N]
-  const ContactSummary& TireContactSummary(int i) const;
+  double WheelLoad(int i) const { return wrench_[i].normal_force; }  ///< last terrain normal force [N]
+  const WheelWrench& wheel_wrench(int i) const { return wrench_[i]; }
+  /// State of wheel i in the world frame (what the terrain is sent).
+  WheelState GetWheelState(int i) const;
+  /// Applies the terrain's wrench on wheel i (world frame, about its centre) from now on.
+  void SetWheelWrench(int i, const WheelWrench& w);
+  /// The time-step limit of a wheel-terrain contact with the given stiffness and damping on the
+  /// lightest wheel (in its worst direction: the contact point on the rim).
+  TimeStepLimit WheelContactLimit(double stiffness, double damping) const;
 
   void SetDriveTorqueRequest(double t) { drive_request_ = t; }
   void SetBrakeEffort(double effort) { brake_effort_ = effort; }
@@ -77,6 +84,10 @@ class Vehicle {
   Eigen::Vector3d chassis_com_offset_ = Eigen::Vector3d::Zero();
   double ride_height_ = 0.0;
   double drive_request_ = 0.0, brake_effort_ = 0.0;
+  std::array<WheelWrench, 4> wrench_{};
 };
+
+/// The tire geometry of the vehicle in `file` (what a terrain needs of the vehicle).
+TireGeometry LoadTireGeometry(const std::string& file);
 
 }  // namespace dem_mobility

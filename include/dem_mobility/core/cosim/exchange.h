@@ -1,0 +1,42 @@
+// What the vehicle and the terrain (and the driver) exchange in the lock-step co-simulation, in
+// core types. The ROS layer converts these one to one into msg/WheelStates, msg/WheelWrenches,
+// msg/DriverInput and msg/DriverCommand (all doubles, so the conversion is exact and a run through
+// nodelets gives the same numbers as the in-process runner).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <vector>
+
+namespace dem_mobility {
+
+/// State of one wheel in the simulation's world frame: centre, orientation, velocities.
+struct WheelState {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          ///< of the centre [m/s]
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< world frame [rad/s]
+};
+
+/// The terrain's wrench on one wheel, world frame, about the wheel centre.
+struct WheelWrench {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< [N]
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();  ///< [N m]
+  double sinkage = 0.0;       ///< deepest penetration [m]
+  int contacts = 0;           ///< contact points in this evaluation
+  double normal_force = 0.0;  ///< sum of the normal contact forces [N]
+  /// Upper bound of the contact's translational stiffness on the wheel [N/m] and its damping
+  /// [N s/m]: the vehicle's time-step guard checks its step against them.
+  double stiffness = 0.0, damping = 0.0;
+};
+
+/// Vehicle -> driver at every control step.
+struct DriveInput {
+  long step = 0;                  ///< vehicle step index
+  double time = 0.0;              ///< since the driver's start [s]
+  double period = 0.0;            ///< control period [s]
+  double forward_speed = 0.0;     ///< [m/s]
+  double drive_shaft_speed = 0.0; ///< [rad/s]
+};
+
+}  // namespace dem_mobility
