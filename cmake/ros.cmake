@@ -1,10 +1,12 @@
-# The ROS layer: messages of the lock-step exchange and results, and the catkin package. The core
-# (src/core) never sees any of this; nodelets (later) link dm_core and the generated messages.
-find_package(catkin REQUIRED COMPONENTS roscpp std_msgs geometry_msgs message_generation)
+# The ROS layer: messages of the lock-step exchange and results, the nodelets (thin wrappers over
+# dm_core), launch files and ROS tests. The core (src/core) never sees any of this.
+find_package(catkin REQUIRED COMPONENTS roscpp nodelet pluginlib rosbag topic_tools std_msgs geometry_msgs nav_msgs
+  sensor_msgs visualization_msgs tf2_msgs rosgraph_msgs message_generation)
 
 add_message_files(DIRECTORY msg FILES
   WheelStates.msg
   WheelWrenches.msg
+  DriverInput.msg
   DriverCommand.msg
   MobilityResult.msg
 )
@@ -12,5 +14,7 @@ generate_messages(DEPENDENCIES std_msgs geometry_msgs)
 
 catkin_package(
   INCLUDE_DIRS include
-  CATKIN_DEPENDS roscpp std_msgs geometry_msgs message_runtime
+  LIBRARIES dem_mobility_nodelets
+  CATKIN_DEPENDS roscpp nodelet std_msgs geometry_msgs nav_msgs visualization_msgs tf2_msgs rosgraph_msgs
+    message_runtime
 )

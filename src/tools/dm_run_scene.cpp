@@ -28,26 +28,6 @@ int Usage() {
   return 2;
 }
 
-void ApplyOverride(YAML::Node root, const std::string& file, const std::string& kv) {
-  const auto eq = kv.find('=');
-  if (eq == std::string::npos || eq == 0) throw ConfigError("override '" + kv + "': expected key=value");
-  const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
-  std::vector<std::string> parts;
-  size_t start = 0, dot;
-  while ((dot = key.find('.', start)) != std::string::npos) {
-    parts.push_back(key.substr(start, dot - start));
-    start = dot + 1;
-  }
-  parts.push_back(key.substr(start));
-  std::vector<YAML::Node> chain{root};
-  for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    YAML::Node next = chain.back()[parts[i]];
-    if (!next.IsMap()) throw ConfigError(file + ": override '" + kv + "': '" + parts[i] + "' is not a map in the scene");
-    chain.push_back(next);
-  }
-  // a key the scene does not have is added; the strict reader then rejects it if it is unknown
-  chain.back()[parts.back()] = YAML::Load(value);
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -67,17 +47,7 @@ int main(int argc, char** argv) {
   RoadSceneParams params;
   std::unique_ptr<RoadScene> scene;
   try {
-    YAML::Node root;
-    try {
-      root = YAML::LoadFile(scene_file);
-    } catch (const YAML::BadFile&) {
-      throw ConfigError(scene_file + ": cannot open file (missing or unreadable)");
-    } catch (const YAML::Exception& e) {
-      throw ConfigError(scene_file + ": malformed YAML: " + e.what());
-    }
-    if (!root.IsMap()) throw ConfigError(scene_file + ": the top level must be a map of keys");
-    for (const auto& o : overrides) ApplyOverride(root, scene_file, o);
-    params = RoadSceneParams::Read(YamlReader(root, scene_file, ""));
+    params = RoadSceneParams::Read(YamlReader::LoadWithOverrides(scene_file, overrides));
     // make sure the results can be written before spending the run on them
     for (const std::string& f : {out_file, history_file}) {
       if (f.empty()) continue;

@@ -34,6 +34,34 @@ YamlReader YamlReader::Load(const std::string& path) {
   return FromString(ss.str(), path);
 }
 
+YamlReader YamlReader::LoadWithOverrides(const std::string& path, const std::vector<std::string>& overrides) {
+  YamlReader r = Load(path);
+  for (const std::string& kv : overrides) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0) throw ConfigError(path + ": override '" + kv + "': expected key=value");
+    const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
+    std::vector<std::string> parts;
+    size_t start = 0, dot;
+    while ((dot = key.find('.', start)) != std::string::npos) {
+      parts.push_back(key.substr(start, dot - start));
+      start = dot + 1;
+    }
+    parts.push_back(key.substr(start));
+    YAML::Node node = r.node_;
+    for (size_t i = 0; i + 1 < parts.size(); ++i) {
+      YAML::Node next = node[parts[i]];
+      if (!next.IsMap()) throw ConfigError(path + ": override '" + kv + "': '" + parts[i] + "' is not a map in the file");
+      node.reset(next);
+    }
+    try {
+      node[parts.back()] = YAML::Load(value);
+    } catch (const YAML::Exception& e) {
+      throw ConfigError(path + ": override '" + kv + "': malformed value: " + e.what());
+    }
+  }
+  return r;
+}
+
 YamlReader YamlReader::FromString(const std::string& text, const std::string& name) {
   YAML::Node root;
   try {

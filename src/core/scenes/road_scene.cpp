@@ -241,14 +241,15 @@ RoadResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, DriverPort& 
   return r;
 }
 
-void WriteRoadResult(const RoadResult& r, const RoadSceneParams& p, const std::string& path) {
+void WriteRoadResult(const RoadResult& r, const RoadSceneParams& p, const std::string& path, const std::string& status,
+                     const std::vector<std::pair<std::string, long>>& published) {
   YAML::Emitter e;
   e << YAML::BeginMap;
   e << YAML::Key << "scene" << YAML::Value << p.file;
   e << YAML::Key << "grade_deg" << YAML::Value << p.grade_deg;
   e << YAML::Key << "speed_made_good" << YAML::Value << r.smg.value;
   e << YAML::Key << "speed_made_good_mph" << YAML::Value << r.smg.value / 0.44704;
-  e << YAML::Key << "status" << YAML::Value << r.smg.status;
+  e << YAML::Key << "status" << YAML::Value << (status.empty() ? r.smg.status : status);
   e << YAML::Key << "window_slope" << YAML::Value << r.smg.window_slope;
   e << YAML::Key << "window_speed_std" << YAML::Value << r.smg.window_std;
   e << YAML::Key << "ended_early" << YAML::Value << r.ended_early;
@@ -264,6 +265,11 @@ void WriteRoadResult(const RoadResult& r, const RoadSceneParams& p, const std::s
   e << YAML::Key << "real_time_factor" << YAML::Value << (r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0);
   e << YAML::Key << "interrupted" << YAML::Value << r.interrupted;
   e << YAML::Key << "error" << YAML::Value << r.error;
+  if (!published.empty()) {
+    e << YAML::Key << "published" << YAML::Value << YAML::BeginMap;
+    for (const auto& [topic, n] : published) e << YAML::Key << topic << YAML::Value << n;
+    e << YAML::EndMap;
+  }
   e << YAML::EndMap;
   std::ofstream out(path);
   if (!out) throw ConfigError(path + ": cannot write the result file");

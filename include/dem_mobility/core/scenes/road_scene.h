@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dem_mobility/core/cosim/exchange.h"
@@ -181,8 +182,11 @@ class RoadScene {
   VehicleCoSim sim_;
 };
 
-/// Writes the result as YAML (speed-made-good, status, timing) to `path`.
-void WriteRoadResult(const RoadResult& r, const RoadSceneParams& p, const std::string& path);
+/// Writes the result as YAML (speed-made-good, status, timing) to `path`. `status` replaces the
+/// detector's status when not empty (error, interrupted); `published` lists message counts by topic.
+void WriteRoadResult(const RoadResult& r, const RoadSceneParams& p, const std::string& path,
+                     const std::string& status = "",
+                     const std::vector<std::pair<std::string, long>>& published = {});
 /// Writes the history as CSV to `path`.
 void WriteRoadHistory(const RoadResult& r, const std::string& path);
 

@@ -1,0 +1,38 @@
+// Core types <-> messages of the lock-step exchange (exact: every number is a float64 both ways),
+// and the parameter plumbing every nodelet shares.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <ros/ros.h>
+
+#include "dem_mobility/DriverCommand.h"
+#include "dem_mobility/DriverInput.h"
+#include "dem_mobility/WheelStates.h"
+#include "dem_mobility/WheelWrenches.h"
+#include "dem_mobility/core/cosim/exchange.h"
+#include "dem_mobility/core/scenes/road_scene.h"
+#include "dem_mobility/ros/lockstep.h"
+
+namespace dem_mobility {
+
+void ToMsg(const std::vector<WheelState>& s, WheelStates* m);
+void FromMsg(const WheelStates& m, std::vector<WheelState>* s);
+void ToMsg(const std::vector<WheelWrench>& w, WheelWrenches* m);
+void FromMsg(const WheelWrenches& m, std::vector<WheelWrench>* w);
+void ToMsg(const DriveInput& in, DriverInput* m);
+DriveInput FromMsg(const DriverInput& m);
+void ToMsg(const DriveCommand& c, DriverCommand* m);
+DriveCommand FromMsg(const DriverCommand& m);
+
+/// The scene every nodelet of a run reads, from the run's namespace `nh`: parameter `scene` (the
+/// file) and the overrides under `override/` (e.g. override/grade_deg: 12, override/driver/kp: 4000;
+/// empty strings are unset), applied as dotted key=value overrides. Throws ConfigError naming the
+/// file (or the parameter).
+RoadSceneParams LoadScene(const ros::NodeHandle& nh);
+/// The exchange settings of a nodelet: `exchange_transport`, `exchange_spin` [s],
+/// `peer_timeout` [s], `startup_timeout` [s].
+ExchangeTiming LoadExchangeTiming(const ros::NodeHandle& pnh, std::string* transport);
+
+}  // namespace dem_mobility

@@ -1,0 +1,279 @@
+// The lock-step exchange between nodelets: a request/response pair of messages per step.
+//
+// Two transports behind one interface:
+//  - "shared_memory": both nodelets in one manager (one process) meet in a named Channel; messages
+//    pass as shared pointers (zero copy) through single-slot mailboxes. A waiting side spins for a
+//    short time (the peer's step is usually shorter than a thread wake-up) and then blocks on a
+//    condition variable, so it costs a core only while it spins.
+//  - "topics": the peers are separate processes (`nodelet standalone`, for debugging); requests and
+//    responses travel on ROS topics and land in the same mailboxes.
+// Either side may leave (nodelet unloaded, process killed): the other gets a clear error, never a
+// hang, because every wait has a deadline and a left peer closes the channel.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include <boost/shared_ptr.hpp>
+#include <ros/ros.h>
+
+namespace dem_mobility {
+
+/// A peer left, did not answer in time, or answered out of order.
+class ExchangeError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A single-slot mailbox: Put replaces the slot and wakes the taker; Take waits for a message newer
+/// than the last one taken. One putter and one taker.
+template <class M>
+class Mailbox {
+ public:
+  using Ptr = boost::shared_ptr<const M>;
+  enum class Wait { kMessage, kTimeout, kClosed };
+
+  void Put(const Ptr& m) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      slot_ = m;
+      seq_.fetch_add(1);
+    }
+    if (sleepers_.load() > 0) cv_.notify_one();
+  }
+  /// Waits up to `timeout` for a new message: spins for up to `spin`, then blocks.
+  Wait Take(std::chrono::nanoseconds spin, std::chrono::nanoseconds timeout, Ptr* out) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!Ready()) {
+      const auto spin_end = t0 + spin;
+      int n = 0;
+      while (!Ready() && !closed_.load(std::memory_order_acquire)) {
+        if ((++n & 63) == 0 && std::chrono::steady_clock::now() >= spin_end) break;
+      }
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (!Ready() && !closed_.load()) {
+      sleepers_.fetch_add(1);
+      cv_.wait_until(lock, t0 + timeout, [this] { return Ready() || closed_.load(); });
+      sleepers_.fetch_sub(1);
+    }
+    if (!Ready()) return closed_.load() ? Wait::kClosed : Wait::kTimeout;
+    taken_ = seq_.load();
+    *out = slot_;
+    return Wait::kMessage;
+  }
+  void Close() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closed_.store(true);
+    }
+    cv_.notify_all();
+  }
+  bool closed() const { return closed_.load(); }
+
+ private:
+  bool Ready() const { return seq_.load(std::memory_order_acquire) != taken_; }
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::atomic<uint64_t> seq_{0};
+  uint64_t taken_ = 0;  ///< only the taker touches it
+  std::atomic<int> sleepers_{0};
+  std::atomic<bool> closed_{false};
+  Ptr slot_;
+};
+
+/// Timing of a side's waits (seconds).
+struct ExchangeTiming {
+  double spin = 50e-6;          ///< spin before blocking
+  double peer_timeout = 10.0;   ///< longest wait for an answer once running
+  double startup_timeout = 60.0;///< longest wait for the first answer (the peer may still be loading)
+};
+
+/// The meeting point of two nodelets of one process: requests one way, responses the other.
+template <class Req, class Resp>
+struct Channel {
+  Mailbox<Req> requests;
+  Mailbox<Resp> responses;
+  std::mutex mutex;
+  std::string closed_by;  ///< who closed it and why
+  void Close(const std::string& why) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (closed_by.empty()) closed_by = why;
+    }
+    requests.Close();
+    responses.Close();
+  }
+  std::string why() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return closed_by;
+  }
+};
+
+/// Process-wide registry of channels by name (the resolved exchange namespace). A channel lives
+/// while either side holds it; a name whose channel was closed gets a fresh one.
+class ChannelRegistry {
+ public:
+  template <class Req, class Resp>
+  static std::shared_ptr<Channel<Req, Resp>> Get(const std::string& name) {
+    static std::mutex mutex;
+    static std::map<std::string, std::weak_ptr<void>> channels;
+    std::lock_guard<std::mutex> lock(mutex);
+    auto it = channels.find(name);
+    if (it != channels.end()) {
+      if (auto p = std::static_pointer_cast<Channel<Req, Resp>>(it->second.lock())) {
+        if (!p->requests.closed()) return p;
+      }
+    }
+    auto p = std::make_shared<Channel<Req, Resp>>();
+    channels[name] = p;
+    return p;
+  }
+};
+
+inline std::chrono::nanoseconds Seconds(double s) {
+  return std::chrono::nanoseconds(static_cast<int64_t>(s * 1e9));
+}
+
+/// The asking side (the vehicle): one Call per exchange.
+template <class Req, class Resp>
+class ExchangeClient {
+ public:
+  using ReqPtr = boost::shared_ptr<const Req>;
+  using RespPtr = boost::shared_ptr<const Resp>;
+  /// `transport`: "shared_memory" or "topics"; `name`: the exchange (topic namespace, resolved);
+  /// `peer`: how errors call the other side ("terrain").
+  ExchangeClient(ros::NodeHandle nh, const std::string& transport, const std::string& name,
+                 const std::string& req_topic, const std::string& resp_topic, const std::string& peer,
+                 const ExchangeTiming& timing)
+      : peer_(peer), timing_(timing) {
+    if (transport == "shared_memory") {
+      channel_ = ChannelRegistry::Get<Req, Resp>(name);
+    } else if (transport == "topics") {
+      own_ = std::make_shared<Channel<Req, Resp>>();
+      pub_ = nh.advertise<Req>(req_topic, 1);
+      auto ch = own_;
+      sub_ = nh.subscribe<Resp>(resp_topic, 1, [ch](const RespPtr& m) { ch->responses.Put(m); },
+                                ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+    } else {
+      throw std::invalid_argument("exchange transport '" + transport + "': use shared_memory or topics");
+    }
+  }
+  ~ExchangeClient() { Leave("the " + peer_ + "'s client left"); }
+
+  /// Sends `req` (step `step`) and waits for the answer to it.
+  RespPtr Call(const ReqPtr& req, uint64_t step) {
+    Channel<Req, Resp>& ch = channel_ ? *channel_ : *own_;
+    if (channel_) {
+      ch.requests.Put(req);
+    } else {
+      if (first_) WaitForSubscriber();
+      pub_.publish(req);
+    }
+    const double timeout = first_ ? timing_.startup_timeout : timing_.peer_timeout;
+    RespPtr resp;
+    switch (ch.responses.Take(Seconds(timing_.spin), Seconds(timeout), &resp)) {
+      case Mailbox<Resp>::Wait::kMessage:
+        break;
+      case Mailbox<Resp>::Wait::kClosed:
+        throw ExchangeError("the " + peer_ + " left the exchange at step " + std::to_string(step) + " (" + ch.why() +
+                            ")");
+      case Mailbox<Resp>::Wait::kTimeout:
+        throw ExchangeError("the " + peer_ + " did not answer step " + std::to_string(step) + " within " +
+                            std::to_string(timeout) + " s (is its nodelet loaded and alive?)");
+    }
+    if (resp->step != step)
+      throw ExchangeError("the " + peer_ + " answered step " + std::to_string(resp->step) + " to step " +
+                          std::to_string(step) + ": the lock-step order is broken");
+    first_ = false;
+    return resp;
+  }
+  /// Leaves the exchange (the peer's waits end at once).
+  void Leave(const std::string& why) {
+    if (channel_) channel_->Close(why);
+  }
+
+ private:
+  void WaitForSubscriber() {
+    const auto end = std::chrono::steady_clock::now() + Seconds(timing_.startup_timeout);
+    while (pub_.getNumSubscribers() == 0 || sub_.getNumPublishers() == 0) {
+      if (std::chrono::steady_clock::now() > end || !ros::ok())
+        throw ExchangeError("no " + peer_ + " on topic " + pub_.getTopic() + " within " +
+                            std::to_string(timing_.startup_timeout) + " s");
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  std::string peer_;
+  ExchangeTiming timing_;
+  std::shared_ptr<Channel<Req, Resp>> channel_, own_;
+  ros::Publisher pub_;
+  ros::Subscriber sub_;
+  bool first_ = true;
+};
+
+/// The answering side (terrain, driver): Wait for a request, Reply to it.
+template <class Req, class Resp>
+class ExchangeServer {
+ public:
+  using ReqPtr = boost::shared_ptr<const Req>;
+  using RespPtr = boost::shared_ptr<const Resp>;
+  ExchangeServer(ros::NodeHandle nh, const std::string& transport, const std::string& name,
+                 const std::string& req_topic, const std::string& resp_topic, const ExchangeTiming& timing)
+      : timing_(timing) {
+    if (transport == "shared_memory") {
+      channel_ = ChannelRegistry::Get<Req, Resp>(name);
+    } else if (transport == "topics") {
+      own_ = std::make_shared<Channel<Req, Resp>>();
+      pub_ = nh.advertise<Resp>(resp_topic, 1);
+      auto ch = own_;
+      sub_ = nh.subscribe<Req>(req_topic, 1, [ch](const ReqPtr& m) { ch->requests.Put(m); }, ros::VoidConstPtr(),
+                               ros::TransportHints().tcpNoDelay());
+    } else {
+      throw std::invalid_argument("exchange transport '" + transport + "': use shared_memory or topics");
+    }
+  }
+  ~ExchangeServer() { Leave("the server left"); }
+
+  /// The next request, or null when the client left (`why` tells) or `stop` was set.
+  ReqPtr Wait(const std::atomic<bool>& stop, std::string* why) {
+    Channel<Req, Resp>& ch = channel_ ? *channel_ : *own_;
+    ReqPtr req;
+    for (;;) {
+      switch (ch.requests.Take(Seconds(timing_.spin), std::chrono::milliseconds(100), &req)) {
+        case Mailbox<Req>::Wait::kMessage:
+          return req;
+        case Mailbox<Req>::Wait::kClosed:
+          *why = ch.why();
+          return nullptr;
+        case Mailbox<Req>::Wait::kTimeout:
+          if (stop.load() || !ros::ok()) {
+            *why = "stopped";
+            return nullptr;
+          }
+      }
+    }
+  }
+  void Reply(const RespPtr& resp) {
+    if (channel_) channel_->responses.Put(resp);
+    else pub_.publish(resp);
+  }
+  void Leave(const std::string& why) {
+    if (channel_) channel_->Close(why);
+  }
+
+ private:
+  ExchangeTiming timing_;
+  std::shared_ptr<Channel<Req, Resp>> channel_, own_;
+  ros::Publisher pub_;
+  ros::Subscriber sub_;
+};
+
+}  // namespace dem_mobility

@@ -1,0 +1,228 @@
+// dem_mobility/BagRecorderNodelet: writes a run's topics to one bag from inside the nodelet
+// manager. In the same process nothing is dropped (unbounded subscriber queues, no network), and
+// the bag is written in simulation-time order (each message's header stamp is its record time;
+// ties go by the order of ~topics), so the same run gives the same bag. When the end topic (the
+// mobility result) arrives, everything is flushed, the bag is closed and, if asked, the run ends.
+#include <algorithm>
+#include <cstring>
+#include <deque>
+#include <filesystem>
+#include <mutex>
+#include <sstream>
+
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <rosbag/bag.h>
+#include <topic_tools/shape_shifter.h>
+
+namespace dem_mobility {
+namespace {
+
+/// Byte offset of the header stamp in a serialized message of this definition: 4 for a message
+/// whose first field is a Header (after seq), 8 for an array of such messages (after the length and
+/// the first element's seq), -1 when there is none.
+int StampOffset(const std::string& definition) {
+  auto first_field = [](const std::string& text, size_t from, size_t to) -> std::string {
+    std::istringstream in(text.substr(from, to - from));
+    std::string line;
+    while (std::getline(in, line)) {
+      const size_t a = line.find_first_not_of(" \t");
+      if (a == std::string::npos || line[a] == '#') continue;
+      if (line.compare(a, 4, "MSG:") == 0 || line.compare(a, 3, "===") == 0) continue;
+      if (line.find('=') != std::string::npos) continue;  // a constant
+      return line.substr(a, line.find_first_of(" \t", a) - a);
+    }
+    return "";
+  };
+  const size_t sep = definition.find("\n=====");
+  const std::string type = first_field(definition, 0, sep == std::string::npos ? definition.size() : sep);
+  auto is_header = [](const std::string& t) { return t == "Header" || t == "std_msgs/Header"; };
+  if (is_header(type)) return 4;
+  if (type.size() > 2 && type.compare(type.size() - 2, 2, "[]") == 0) {
+    const std::string elem = type.substr(0, type.size() - 2);
+    const std::string bare = elem.substr(elem.rfind('/') == std::string::npos ? 0 : elem.rfind('/') + 1);
+    size_t pos = 0;
+    while ((pos = definition.find("MSG: ", pos)) != std::string::npos) {
+      const size_t eol = definition.find('\n', pos);
+      const std::string name = definition.substr(pos + 5, eol - pos - 5);
+      const size_t slash = name.rfind('/');
+      if (name == elem || name.substr(slash == std::string::npos ? 0 : slash + 1) == bare) {
+        const size_t next = definition.find("\n=====", eol);
+        return is_header(first_field(definition, eol, next == std::string::npos ? definition.size() : next)) ? 8 : -1;
+      }
+      pos = eol;
+    }
+  }
+  return -1;
+}
+
+}  // namespace
+
+class BagRecorderNodelet : public nodelet::Nodelet {
+ public:
+  ~BagRecorderNodelet() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Close("the recorder was unloaded before the end of the run");
+  }
+
+ private:
+  struct Pending {
+    ros::Time stamp;
+    topic_tools::ShapeShifter::ConstPtr msg;
+    boost::shared_ptr<ros::M_string> header;
+  };
+  struct Topic {
+    std::string name;     ///< resolved
+    bool stream = false;  ///< gates the ordering (publishes all run long)
+    int stamp_offset = -2;///< -2: not yet known
+    ros::Time latest;     ///< newest stamp received
+    bool seen = false;
+    long count = 0;
+    std::deque<Pending> queue;
+    ros::Subscriber sub;
+  };
+
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& pnh = getPrivateNodeHandle();
+    std::vector<std::string> topics, stream;
+    std::string end;
+    if (!pnh.getParam("bag", path_) || path_.empty()) return Fatal("parameter " + pnh.resolveName("bag") + " is not set");
+    if (!pnh.getParam("topics", topics) || topics.empty())
+      return Fatal("parameter " + pnh.resolveName("topics") + " (the list of topics to record) is not set");
+    pnh.getParam("stream_topics", stream);
+    pnh.param<std::string>("end_topic", end, "");
+    pnh.param("shutdown_when_done", shutdown_when_done_, false);
+    try {
+      const std::filesystem::path parent = std::filesystem::path(path_).parent_path();
+      if (!parent.empty()) std::filesystem::create_directories(parent);
+      bag_.open(path_, rosbag::bagmode::Write);
+    } catch (const std::exception& e) {
+      return Fatal("parameter " + pnh.resolveName("bag") + ": cannot write the bag '" + path_ + "': " + e.what());
+    }
+    open_ = true;
+    topics_.resize(topics.size());
+    for (size_t i = 0; i < topics.size(); ++i) {
+      Topic& t = topics_[i];
+      t.name = nh.resolveName(topics[i]);
+      t.stream = std::find(stream.begin(), stream.end(), topics[i]) != stream.end();
+      if (topics[i] == end) end_index_ = static_cast<int>(i);
+    }
+    for (const std::string& s : stream)
+      if (std::find(topics.begin(), topics.end(), s) == topics.end())
+        return Fatal("parameter " + pnh.resolveName("stream_topics") + ": '" + s + "' is not in ~topics");
+    if (!end.empty() && end_index_ < 0)
+      return Fatal("parameter " + pnh.resolveName("end_topic") + ": '" + end + "' is not in ~topics");
+    // unbounded queues (0): in this process nothing is dropped
+    for (size_t i = 0; i < topics_.size(); ++i) {
+      topics_[i].sub = nh.subscribe<topic_tools::ShapeShifter>(
+          topics_[i].name, 0, boost::bind(&BagRecorderNodelet::OnMessage, this, i, boost::placeholders::_1));
+    }
+    NODELET_INFO("recording %zu topics to %s", topics_.size(), path_.c_str());
+  }
+
+  void Fatal(const std::string& what) {
+    NODELET_FATAL("%s", what.c_str());
+    ros::requestShutdown();
+  }
+
+  void OnMessage(size_t index, const ros::MessageEvent<topic_tools::ShapeShifter const>& event) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!open_) return;
+    Topic& t = topics_[index];
+    const auto& msg = event.getConstMessage();
+    if (t.stamp_offset == -2) t.stamp_offset = StampOffset(msg->getMessageDefinition());
+    ros::Time stamp = last_written_;
+    if (t.stamp_offset >= 0 && msg->size() >= static_cast<uint32_t>(t.stamp_offset) + 8) {
+      std::vector<uint8_t> buf(msg->size());
+      ros::serialization::OStream out(buf.data(), buf.size());
+      msg->write(out);
+      const bool array = t.stamp_offset == 8;
+      uint32_t n = 1, sec, nsec;
+      if (array) std::memcpy(&n, buf.data(), 4);
+      if (n > 0) {
+        std::memcpy(&sec, buf.data() + t.stamp_offset, 4);
+        std::memcpy(&nsec, buf.data() + t.stamp_offset + 4, 4);
+        stamp = ros::Time(sec, nsec);
+      }
+    }
+    // the connection header the bag keeps: what the message is, who sent it, whether it was
+    // latched (so that a replay latches it again); nothing that changes from run to run
+    auto header = boost::make_shared<ros::M_string>();
+    (*header)["topic"] = t.name;
+    (*header)["type"] = msg->getDataType();
+    (*header)["md5sum"] = msg->getMD5Sum();
+    (*header)["message_definition"] = msg->getMessageDefinition();
+    (*header)["callerid"] = event.getPublisherName();
+    const auto& in = event.getConnectionHeaderPtr();
+    (*header)["latching"] = in && in->count("latching") ? in->at("latching") : "0";
+    t.queue.push_back({stamp, msg, header});
+    ++t.count;
+    if (t.stream) {
+      t.latest = stamp;
+      t.seen = true;
+    }
+    if (static_cast<int>(index) == end_index_) {
+      Close("");
+      if (shutdown_when_done_) ros::requestShutdown();
+      return;
+    }
+    // a message older than the newest of every stream topic can no longer be preceded by another
+    ros::Time safe = ros::TIME_MAX;
+    bool any_stream = false;
+    for (const Topic& s : topics_) {
+      if (!s.stream) continue;
+      any_stream = true;
+      if (!s.seen) return;
+      safe = std::min(safe, s.latest);
+    }
+    if (any_stream) Write(safe);
+  }
+
+  /// Writes every queued message stamped before `limit`, oldest first (ties in topic order).
+  void Write(const ros::Time& limit) {
+    for (;;) {
+      int best = -1;
+      for (size_t i = 0; i < topics_.size(); ++i) {
+        const auto& q = topics_[i].queue;
+        if (q.empty() || !(q.front().stamp < limit)) continue;
+        if (best < 0 || q.front().stamp < topics_[best].queue.front().stamp) best = static_cast<int>(i);
+      }
+      if (best < 0) return;
+      Pending p = std::move(topics_[best].queue.front());
+      topics_[best].queue.pop_front();
+      // rosbag refuses record times below TIME_MIN (the stamp 0 of the first messages)
+      const ros::Time record = std::max(p.stamp, ros::TIME_MIN);
+      bag_.write(topics_[best].name, record, *p.msg, p.header);
+      last_written_ = std::max(last_written_, p.stamp);
+    }
+  }
+
+  void Close(const std::string& why) {
+    if (!open_) return;
+    open_ = false;
+    try {
+      Write(ros::TIME_MAX);
+      bag_.close();
+    } catch (const std::exception& e) {
+      NODELET_ERROR("bag %s: %s", path_.c_str(), e.what());
+      return;
+    }
+    std::ostringstream counts;
+    for (const Topic& t : topics_) counts << " " << t.name << "=" << t.count;
+    if (why.empty()) NODELET_INFO("bag %s closed:%s", path_.c_str(), counts.str().c_str());
+    else NODELET_WARN("bag %s closed early (%s):%s", path_.c_str(), why.c_str(), counts.str().c_str());
+  }
+
+  std::mutex mutex_;
+  std::string path_;
+  rosbag::Bag bag_;
+  bool open_ = false, shutdown_when_done_ = false;
+  std::vector<Topic> topics_;
+  int end_index_ = -1;
+  ros::Time last_written_;
+};
+
+}  // namespace dem_mobility
+
+PLUGINLIB_EXPORT_CLASS(dem_mobility::BagRecorderNodelet, nodelet::Nodelet)

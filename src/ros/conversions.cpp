@@ -1,0 +1,174 @@
+#include "dem_mobility/ros/conversions.h"
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+
+namespace dem_mobility {
+namespace {
+geometry_msgs::Vector3 V(const Eigen::Vector3d& v) {
+  geometry_msgs::Vector3 m;
+  m.x = v.x();
+  m.y = v.y();
+  m.z = v.z();
+  return m;
+}
+Eigen::Vector3d E(const geometry_msgs::Vector3& m) { return {m.x, m.y, m.z}; }
+}  // namespace
+
+void ToMsg(const std::vector<WheelState>& s, WheelStates* m) {
+  m->poses.resize(s.size());
+  m->twists.resize(s.size());
+  for (size_t i = 0; i < s.size(); ++i) {
+    auto& p = m->poses[i];
+    p.position.x = s[i].position.x();
+    p.position.y = s[i].position.y();
+    p.position.z = s[i].position.z();
+    p.orientation.w = s[i].orientation.w();
+    p.orientation.x = s[i].orientation.x();
+    p.orientation.y = s[i].orientation.y();
+    p.orientation.z = s[i].orientation.z();
+    m->twists[i].linear = V(s[i].velocity);
+    m->twists[i].angular = V(s[i].angular_velocity);
+  }
+}
+
+void FromMsg(const WheelStates& m, std::vector<WheelState>* s) {
+  DM_THROW_UNLESS(m.poses.size() == m.twists.size(), "WheelStates step ", m.step, ": ", m.poses.size(), " poses but ",
+                  m.twists.size(), " twists");
+  s->resize(m.poses.size());
+  for (size_t i = 0; i < m.poses.size(); ++i) {
+    const auto& p = m.poses[i];
+    (*s)[i].position = {p.position.x, p.position.y, p.position.z};
+    (*s)[i].orientation = Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z);
+    (*s)[i].velocity = E(m.twists[i].linear);
+    (*s)[i].angular_velocity = E(m.twists[i].angular);
+  }
+}
+
+void ToMsg(const std::vector<WheelWrench>& w, WheelWrenches* m) {
+  const size_t n = w.size();
+  m->wrenches.resize(n);
+  m->sinkage.resize(n);
+  m->contacts.resize(n);
+  m->normal_force.resize(n);
+  m->stiffness.resize(n);
+  m->damping.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    m->wrenches[i].force = V(w[i].force);
+    m->wrenches[i].torque = V(w[i].moment);
+    m->sinkage[i] = w[i].sinkage;
+    m->contacts[i] = static_cast<uint32_t>(w[i].contacts);
+    m->normal_force[i] = w[i].normal_force;
+    m->stiffness[i] = w[i].stiffness;
+    m->damping[i] = w[i].damping;
+  }
+}
+
+void FromMsg(const WheelWrenches& m, std::vector<WheelWrench>* w) {
+  const size_t n = m.wrenches.size();
+  DM_THROW_UNLESS(m.sinkage.size() == n && m.contacts.size() == n && m.normal_force.size() == n &&
+                      m.stiffness.size() == n && m.damping.size() == n,
+                  "WheelWrenches step ", m.step, ": arrays of different lengths");
+  w->resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    (*w)[i].force = E(m.wrenches[i].force);
+    (*w)[i].moment = E(m.wrenches[i].torque);
+    (*w)[i].sinkage = m.sinkage[i];
+    (*w)[i].contacts = static_cast<int>(m.contacts[i]);
+    (*w)[i].normal_force = m.normal_force[i];
+    (*w)[i].stiffness = m.stiffness[i];
+    (*w)[i].damping = m.damping[i];
+  }
+}
+
+void ToMsg(const DriveInput& in, DriverInput* m) {
+  m->step = static_cast<uint64_t>(in.step);
+  m->time = in.time;
+  m->period = in.period;
+  m->forward_speed = in.forward_speed;
+  m->drive_shaft_speed = in.drive_shaft_speed;
+}
+
+DriveInput FromMsg(const DriverInput& m) {
+  DriveInput in;
+  in.step = static_cast<long>(m.step);
+  in.time = m.time;
+  in.period = m.period;
+  in.forward_speed = m.forward_speed;
+  in.drive_shaft_speed = m.drive_shaft_speed;
+  return in;
+}
+
+void ToMsg(const DriveCommand& c, DriverCommand* m) {
+  m->speed_command = c.speed_command;
+  m->torque_request = c.torque_request;
+  m->drive_torque = c.drive_torque;
+  m->brake_effort = c.brake_effort;
+  m->steering = 0.0;
+  m->wot_limited = c.wot_limited;
+}
+
+DriveCommand FromMsg(const DriverCommand& m) {
+  DriveCommand c;
+  c.speed_command = m.speed_command;
+  c.torque_request = m.torque_request;
+  c.drive_torque = m.drive_torque;
+  c.brake_effort = m.brake_effort;
+  c.wot_limited = m.wot_limited;
+  return c;
+}
+
+namespace {
+void Flatten(const XmlRpc::XmlRpcValue& v, const std::string& prefix, std::vector<std::string>* out) {
+  switch (v.getType()) {
+    case XmlRpc::XmlRpcValue::TypeStruct:
+      for (auto it = v.begin(); it != v.end(); ++it)
+        Flatten(it->second, prefix.empty() ? it->first : prefix + "." + it->first, out);
+      break;
+    case XmlRpc::XmlRpcValue::TypeString: {
+      const std::string s = static_cast<std::string>(const_cast<XmlRpc::XmlRpcValue&>(v));
+      if (!s.empty()) out->push_back(prefix + "=" + s);
+      break;
+    }
+    case XmlRpc::XmlRpcValue::TypeDouble:
+      out->push_back(prefix + "=" + detail::Concat(static_cast<double>(const_cast<XmlRpc::XmlRpcValue&>(v))));
+      break;
+    case XmlRpc::XmlRpcValue::TypeInt:
+      out->push_back(prefix + "=" + std::to_string(static_cast<int>(const_cast<XmlRpc::XmlRpcValue&>(v))));
+      break;
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      out->push_back(prefix + "=" + (static_cast<bool>(const_cast<XmlRpc::XmlRpcValue&>(v)) ? "true" : "false"));
+      break;
+    default:
+      throw ConfigError("parameter override/" + prefix + ": only numbers, strings and booleans can override a scene key");
+  }
+}
+}  // namespace
+
+RoadSceneParams LoadScene(const ros::NodeHandle& nh) {
+  std::string file;
+  if (!nh.getParam("scene", file) || file.empty())
+    throw ConfigError("parameter " + nh.resolveName("scene") + " (the scene file) is not set");
+  std::vector<std::string> overrides;
+  XmlRpc::XmlRpcValue o;
+  if (nh.getParam("override", o)) Flatten(o, "", &overrides);
+  // relative paths in overrides (vehicle:=, terrain:=) are the user's, relative to where they ran
+  return RoadSceneParams::Read(YamlReader::LoadWithOverrides(file, overrides));
+}
+
+ExchangeTiming LoadExchangeTiming(const ros::NodeHandle& pnh, std::string* transport) {
+  ExchangeTiming t;
+  pnh.param<std::string>("exchange_transport", *transport, "shared_memory");
+  pnh.param("exchange_spin", t.spin, t.spin);
+  pnh.param("peer_timeout", t.peer_timeout, t.peer_timeout);
+  pnh.param("startup_timeout", t.startup_timeout, t.startup_timeout);
+  if (*transport != "shared_memory" && *transport != "topics")
+    throw ConfigError("parameter " + pnh.resolveName("exchange_transport") + ": '" + *transport +
+                      "' is not a transport (shared_memory or topics)");
+  if (!(t.spin >= 0.0 && t.spin <= 1.0)) throw ConfigError("parameter " + pnh.resolveName("exchange_spin") + " must be in [0, 1] s");
+  if (!(t.peer_timeout > 0.0)) throw ConfigError("parameter " + pnh.resolveName("peer_timeout") + " must be positive");
+  if (!(t.startup_timeout > 0.0)) throw ConfigError("parameter " + pnh.resolveName("startup_timeout") + " must be positive");
+  return t;
+}
+
+}  // namespace dem_mobility

@@ -1,0 +1,135 @@
+// dem_mobility/TerrainNodelet: the terrain side of the lock-step exchange. Builds the scene's
+// terrain model (core), answers each WheelStates with the WheelWrenches of the same step, and
+// shows the surface in rviz. No physics here: the model computes, the nodelet converts.
+#include <atomic>
+#include <thread>
+
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/ros/conversions.h"
+
+namespace dem_mobility {
+
+class TerrainNodelet : public nodelet::Nodelet {
+ public:
+  ~TerrainNodelet() override {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& pnh = getPrivateNodeHandle();
+    std::string transport;
+    try {
+      const RoadSceneParams scene = LoadScene(nh);
+      const ExchangeTiming timing = LoadExchangeTiming(pnh, &transport);
+      pnh.param<std::string>("frame_id", frame_id_, "odom");
+      model_ = LoadTerrainModel(scene.terrain_file, scene.vehicle_file);
+      server_ = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
+          nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches", timing);
+      NODELET_INFO("terrain '%s' from %s (%zu triangles), exchange over %s", model_->kind().c_str(),
+                   scene.terrain_file.c_str(), model_->Surface().faces.size(), transport.c_str());
+    } catch (const std::exception& e) {
+      NODELET_FATAL("%s", e.what());
+      ros::requestShutdown();
+      return;
+    }
+    markers_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/markers", 1, true);
+    PublishSurface();
+    thread_ = std::thread([this] { Serve(); });
+  }
+
+  void Serve() {
+    std::vector<WheelState> states;
+    std::vector<WheelWrench> wrenches;
+    uint64_t served = 0;
+    long last_step = -1;
+    std::string why;
+    try {
+      while (auto req = server_->Wait(stop_, &why)) {
+        const long step = static_cast<long>(req->step);
+        DM_THROW_UNLESS(step > last_step, "wheel states of step ", step, " after step ", last_step,
+                        ": the lock-step order is broken");
+        FromMsg(*req, &states);
+        model_->Compute(step, req->header.stamp.toSec(), states, &wrenches);
+        auto resp = boost::make_shared<WheelWrenches>();
+        resp->header.stamp = req->header.stamp;
+        resp->header.frame_id = req->header.frame_id;
+        resp->step = req->step;
+        resp->served = ++served;
+        ToMsg(wrenches, resp.get());
+        server_->Reply(resp);
+        last_step = step;
+      }
+      NODELET_INFO("terrain: %lu exchanges answered; the exchange ended (%s)", static_cast<unsigned long>(served),
+                   why.c_str());
+    } catch (const std::exception& e) {
+      NODELET_ERROR("terrain: %s", e.what());
+      server_->Leave(std::string("the terrain failed: ") + e.what());
+    }
+  }
+
+  void PublishSurface() {
+    const TriMesh& mesh = model_->Surface();
+    visualization_msgs::MarkerArray arr;
+    visualization_msgs::Marker m;
+    m.header.frame_id = frame_id_;
+    m.ns = "terrain_surface";
+    m.id = 0;
+    m.type = visualization_msgs::Marker::TRIANGLE_LIST;
+    m.action = visualization_msgs::Marker::ADD;
+    m.pose.orientation.w = 1.0;
+    m.scale.x = m.scale.y = m.scale.z = 1.0;
+    m.color.r = 0.42f;
+    m.color.g = 0.42f;
+    m.color.b = 0.45f;
+    m.color.a = 1.0f;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e30), hi = -lo;
+    for (const auto& f : mesh.faces)
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d& v = mesh.vertices[f[k]];
+        geometry_msgs::Point p;
+        p.x = v.x();
+        p.y = v.y();
+        p.z = v.z();
+        m.points.push_back(p);
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+      }
+    arr.markers.push_back(m);
+    // cross lines every 5 m so that motion along the surface is visible
+    visualization_msgs::Marker l = m;
+    l.ns = "terrain_lines";
+    l.type = visualization_msgs::Marker::LINE_LIST;
+    l.points.clear();
+    l.scale.x = 0.05;
+    l.color.r = l.color.g = l.color.b = 0.9f;
+    for (double x = std::ceil(lo.x() / 5.0) * 5.0; x <= hi.x(); x += 5.0) {
+      geometry_msgs::Point a, b;
+      a.x = b.x = x;
+      a.y = lo.y();
+      b.y = hi.y();
+      a.z = b.z = hi.z() + 0.005;
+      l.points.push_back(a);
+      l.points.push_back(b);
+    }
+    arr.markers.push_back(l);
+    markers_.publish(arr);
+  }
+
+  std::unique_ptr<TerrainModel> model_;
+  std::unique_ptr<ExchangeServer<WheelStates, WheelWrenches>> server_;
+  ros::Publisher markers_;
+  std::string frame_id_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace dem_mobility
+
+PLUGINLIB_EXPORT_CLASS(dem_mobility::TerrainNodelet, nodelet::Nodelet)

@@ -1,0 +1,350 @@
+// dem_mobility/VehicleNodelet: the vehicle side of the co-simulation and its clock. Runs the core's
+// scene loop (RunCoSimulation) with the terrain and the driver reached through lock-step exchanges,
+// and publishes what users watch and keep: /clock, tf (every body), odometry, the exchanged wheel
+// states, wrenches and driver commands (decimated to log_rate), markers, progress, the result.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include <nav_msgs/Odometry.h>
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <rosgraph_msgs/Clock.h>
+#include <tf2_msgs/TFMessage.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "dem_mobility/MobilityResult.h"
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/ros/conversions.h"
+#include "dem_mobility/ros/vehicle_visuals.h"
+
+namespace dem_mobility {
+namespace {
+
+/// The terrain reached through the lock-step exchange.
+class ExchangeTerrainPort final : public TerrainPort {
+ public:
+  ExchangeTerrainPort(std::unique_ptr<ExchangeClient<WheelStates, WheelWrenches>> client, std::string frame)
+      : client_(std::move(client)), frame_(std::move(frame)) {}
+  void Exchange(long step, double t, double dt, const std::vector<WheelState>& states,
+                std::vector<WheelWrench>* wrenches) override {
+    auto req = boost::make_shared<WheelStates>();
+    req->header.stamp = ros::Time(t);
+    req->header.frame_id = frame_;
+    req->step = static_cast<uint64_t>(step);
+    req->time_step = dt;
+    ToMsg(states, req.get());
+    try {
+      last_resp = client_->Call(req, req->step);
+      FromMsg(*last_resp, wrenches);
+    } catch (const std::exception& e) {
+      throw SimulationError(e.what());
+    }
+    last_req = req;
+  }
+  void Leave(const std::string& why) { client_->Leave(why); }
+  boost::shared_ptr<const WheelStates> last_req;
+  boost::shared_ptr<const WheelWrenches> last_resp;
+
+ private:
+  std::unique_ptr<ExchangeClient<WheelStates, WheelWrenches>> client_;
+  std::string frame_;
+};
+
+/// The driver reached through the lock-step exchange.
+class ExchangeDriverPort final : public DriverPort {
+ public:
+  explicit ExchangeDriverPort(std::unique_ptr<ExchangeClient<DriverInput, DriverCommand>> client)
+      : client_(std::move(client)) {}
+  DriveCommand Exchange(const DriveInput& in) override {
+    auto req = boost::make_shared<DriverInput>();
+    req->header.stamp = ros::Time(stamp_offset + in.time);
+    ToMsg(in, req.get());
+    try {
+      last_resp = client_->Call(req, req->step);
+      return FromMsg(*last_resp);
+    } catch (const std::exception& e) {
+      throw SimulationError(e.what());
+    }
+  }
+  void Leave(const std::string& why) { client_->Leave(why); }
+  double stamp_offset = 0.0;  ///< simulation time of the driver's start
+  boost::shared_ptr<const DriverCommand> last_resp;
+
+ private:
+  std::unique_ptr<ExchangeClient<DriverInput, DriverCommand>> client_;
+};
+
+/// A publisher that counts what it published (the bag test compares the counts).
+struct Counted {
+  ros::Publisher pub;
+  std::string name;
+  long count = 0;
+  template <class M>
+  void Publish(const M& m) {
+    pub.publish(m);
+    ++count;
+  }
+};
+
+}  // namespace
+
+class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
+ public:
+  ~VehicleNodelet() override {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& pnh = getPrivateNodeHandle();
+    try {
+      scene_ = LoadScene(nh);
+      std::string transport;
+      const ExchangeTiming timing = LoadExchangeTiming(pnh, &transport);
+      pnh.param<std::string>("world_frame", world_frame_, "odom");
+      pnh.param<std::string>("map_frame", map_frame_, "map");
+      pnh.param<std::string>("base_frame", base_frame_, "base_link");
+      double log_rate = 100.0, clock_rate = 100.0;
+      pnh.param("log_rate", log_rate, log_rate);
+      pnh.param("clock_rate", clock_rate, clock_rate);
+      pnh.param("max_real_time_factor", max_rtf_, 0.0);
+      pnh.param<std::string>("result_file", result_file_, "");
+      pnh.param("wait_for_recorder", wait_for_recorder_, true);
+      pnh.param("shutdown_when_done", shutdown_when_done_, false);
+      pnh.param("force_scale", force_scale_, 1e-4);
+      auto check = [&pnh](bool ok, const std::string& name, const std::string& what) {
+        if (!ok) throw ConfigError("parameter " + pnh.resolveName(name) + ": " + what);
+      };
+      check(log_rate >= 0.0, "log_rate", "must be >= 0 Hz (0: every step)");
+      check(clock_rate > 0.0, "clock_rate", "must be > 0 Hz");
+      check(max_rtf_ >= 0.0, "max_real_time_factor", "must be >= 0 (0: as fast as possible)");
+      log_rate_ = log_rate;
+      clock_rate_ = clock_rate;
+      if (!result_file_.empty()) {
+        const std::filesystem::path parent = std::filesystem::path(result_file_).parent_path();
+        std::error_code ec;
+        if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+        check(static_cast<bool>(std::ofstream(result_file_, std::ios::app)), "result_file",
+              "cannot write '" + result_file_ + "'");
+      }
+      sim_ = std::make_unique<VehicleCoSim>(scene_);
+      terrain_ = std::make_unique<ExchangeTerrainPort>(
+          std::make_unique<ExchangeClient<WheelStates, WheelWrenches>>(
+              nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches",
+              "terrain", timing),
+          world_frame_);
+      driver_ = std::make_unique<ExchangeDriverPort>(std::make_unique<ExchangeClient<DriverInput, DriverCommand>>(
+          nh, transport, nh.resolveName("exchange/driver"), "exchange/driver_input", "exchange/driver_command", "driver",
+          timing));
+      NODELET_INFO("vehicle '%s' (%d bodies) on %s, grade %.2f deg, exchange over %s",
+                   sim_->vehicle().name().c_str(), sim_->vehicle().system().num_bodies() - 1, scene_.file.c_str(),
+                   scene_.grade_deg, transport.c_str());
+    } catch (const std::exception& e) {
+      Fail(std::string(e.what()));
+      return;
+    }
+    Advertise(nh);
+    thread_ = std::thread([this] { Run(); });
+  }
+
+  void Advertise(ros::NodeHandle& nh) {
+    auto add = [this](Counted* c, ros::Publisher p, const std::string& name) {
+      c->pub = p;
+      c->name = name;
+      counted_.push_back(c);
+    };
+    // queues large enough that a burst to a slow remote subscriber is not dropped
+    const uint32_t q = 10000;
+    ros::NodeHandle root;
+    add(&clock_, root.advertise<rosgraph_msgs::Clock>("/clock", 10), "clock");
+    add(&tf_, root.advertise<tf2_msgs::TFMessage>("/tf", q), "tf");
+    add(&tf_static_, root.advertise<tf2_msgs::TFMessage>("/tf_static", 1, true), "tf_static");
+    add(&odom_, nh.advertise<nav_msgs::Odometry>("odom", q), "odom");
+    add(&states_, nh.advertise<WheelStates>("wheel_states", q), "wheel_states");
+    add(&wrenches_, nh.advertise<WheelWrenches>("wheel_wrenches", q), "wheel_wrenches");
+    add(&command_, nh.advertise<DriverCommand>("driver_command", q), "driver_command");
+    add(&body_markers_, nh.advertise<visualization_msgs::MarkerArray>("vehicle/markers", q, true), "vehicle/markers");
+    add(&live_markers_, nh.advertise<visualization_msgs::MarkerArray>("vehicle/forces", q), "vehicle/forces");
+    add(&result_, nh.advertise<MobilityResult>("result", 1, true), "result");
+  }
+
+  /// Waits until every logged topic has a subscriber (the recorder), so nothing is lost at the start.
+  void WaitForRecorder() {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    for (;;) {
+      bool all = true;
+      for (const Counted* c : counted_)
+        if (c != &clock_ && c->pub.getNumSubscribers() == 0) all = false;
+      if (all) return;
+      if (std::chrono::steady_clock::now() > end)
+        throw ConfigError("no recorder subscribed to the logged topics within 60 s (set ~wait_for_recorder false "
+                          "to run without one)");
+      if (stop_ || !ros::ok()) throw ConfigError("stopped while waiting for the recorder");
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
+  void Run() {
+    RoadResult r;
+    try {
+      if (wait_for_recorder_) WaitForRecorder();
+      PublishStatic();
+      sim_->Start(*terrain_);
+      const double dt = sim_->dt();
+      log_every_ = log_rate_ > 0.0 ? std::max(1L, std::lround(1.0 / (log_rate_ * dt))) : 1;
+      clock_every_ = std::max(1L, std::lround(1.0 / (clock_rate_ * dt)));
+      driver_->stamp_offset = scene_.settle_time;
+      NODELET_INFO("time step %.4g s (critical %.4g s: %s), coupling every %d step(s), logging every %ld step(s), "
+                   "%.1f s of driving after %.2f s of settling",
+                   dt, sim_->limit().dt_crit, sim_->limit().element.c_str(), scene_.coupling_interval, log_every_,
+                   scene_.duration, scene_.settle_time);
+      wall0_ = std::chrono::steady_clock::now();
+      r = RunCoSimulation(*sim_, *terrain_, *driver_, this);
+    } catch (const std::exception& e) {  // configuration errors (time step) before the first step
+      r.error = e.what();
+    }
+    const std::string why = !r.error.empty() ? "the vehicle stopped: " + r.error : "the vehicle finished";
+    terrain_->Leave(why);
+    driver_->Leave(why);
+    Finish(r);
+  }
+
+  // --- CoSimObserver
+  void OnStep(const VehicleCoSim& sim, const DriveCommand& /*cmd*/) override {
+    const long k = sim.step();
+    if (k % clock_every_ == 0) {
+      rosgraph_msgs::Clock c;
+      c.clock = ros::Time(sim.time());
+      clock_.Publish(c);
+      Pace(sim.time());
+    }
+    if (k % log_every_ == 0) Log(sim);
+    if ((k & 255) == 0) Progress(sim);
+  }
+  bool StopRequested() override { return stop_.load() || !ros::ok(); }
+
+  void Pace(double t_sim) {
+    if (max_rtf_ <= 0.0) return;
+    const auto due = wall0_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                  std::chrono::duration<double>(t_sim / max_rtf_));
+    std::this_thread::sleep_until(due);
+  }
+
+  void Progress(const VehicleCoSim& sim) {
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+    if (wall < next_progress_) return;
+    next_progress_ += 1.0;
+    const double t = std::max(0.0, sim.driver_time()), rtf = sim.time() / wall;
+    NODELET_INFO("t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s", t, scene_.duration,
+                 sim.vehicle().ForwardSpeed(), rtf, (scene_.duration - t) / std::max(rtf, 1e-9));
+  }
+
+  void Log(const VehicleCoSim& sim) {
+    const ros::Time stamp(sim.time());
+    const Vehicle& v = sim.vehicle();
+    // the exchanged messages themselves (zero copy); the latest ones when the coupling skips steps
+    if (terrain_->last_req && terrain_->last_req != logged_req_) {
+      states_.Publish(terrain_->last_req);
+      wrenches_.Publish(terrain_->last_resp);
+      logged_req_ = terrain_->last_req;
+    }
+    if (driver_->last_resp && driver_->last_resp != logged_cmd_) {
+      command_.Publish(driver_->last_resp);
+      logged_cmd_ = driver_->last_resp;
+    }
+    tf_.Publish(BodyTransforms(v, stamp, world_frame_, base_frame_));
+    odom_.Publish(ChassisOdometry(v, stamp, world_frame_, base_frame_));
+    live_markers_.Publish(LiveMarkers(sim, stamp, world_frame_, force_scale_));
+    if (sim.time() >= next_body_markers_) {  // frame-locked body shapes: once a simulated second
+      body_markers_.Publish(BodyMarkers(v, stamp, base_frame_));
+      next_body_markers_ += 1.0;
+    }
+  }
+
+  void PublishStatic() {
+    tf2_msgs::TFMessage m;
+    m.transforms.push_back(GradeTransform(scene_.grade_deg, ros::Time(0), map_frame_, world_frame_));
+    tf_static_.Publish(m);
+  }
+
+  void Finish(const RoadResult& r) {
+    MobilityResult m;
+    m.header.stamp = ros::Time(sim_ ? sim_->time() : 0.0);
+    m.header.frame_id = world_frame_;
+    m.scene = scene_.file;
+    m.grade_deg = scene_.grade_deg;
+    m.cone_index_psi = 300.0;
+    m.terrain_model = "rigid_road";
+    m.speed_made_good = r.smg.value;
+    m.status = !r.error.empty() ? "error" : (r.interrupted ? "interrupted" : r.smg.status);
+    m.window_slope = r.smg.window_slope;
+    m.time_step = r.dt;
+    m.critical_time_step = r.dt_crit;
+    m.critical_element = r.dt_limit_element;
+    m.coupling_interval = static_cast<uint32_t>(scene_.coupling_interval);
+    m.steps = static_cast<uint64_t>(r.steps);
+    m.exchanges = static_cast<uint64_t>(r.exchanges);
+    m.simulated_time = r.sim_time;
+    m.wall_time = r.wall_time;
+    m.real_time_factor = r.wall_time > 0.0 && sim_ ? sim_->time() / r.wall_time : 0.0;
+    m.error = r.error;
+    result_.Publish(m);
+    if (!r.error.empty()) NODELET_ERROR("run failed: %s", r.error.c_str());
+    NODELET_INFO("speed_made_good: %.3f m/s (%.2f mph), status %s; %ld steps, %.2f s driven in %.2f s wall",
+                 r.smg.value, r.smg.value / 0.44704, m.status.c_str(), r.steps, r.sim_time, r.wall_time);
+    if (!result_file_.empty()) {
+      std::vector<std::pair<std::string, long>> counts;
+      for (const Counted* c : counted_) counts.emplace_back(c->name, c->count);
+      try {
+        WriteRoadResult(r, scene_, result_file_, m.status, counts);
+        NODELET_INFO("result: %s", result_file_.c_str());
+      } catch (const std::exception& e) {
+        NODELET_ERROR("%s", e.what());
+      }
+    }
+    if (shutdown_when_done_) ros::requestShutdown();
+  }
+
+  /// A setup error: said clearly, written to the result file when one is set, and the run ends.
+  void Fail(const std::string& what) {
+    NODELET_FATAL("%s", what.c_str());
+    if (!result_file_.empty()) {
+      RoadResult r;
+      r.error = what;
+      try {
+        WriteRoadResult(r, scene_, result_file_, "error", {});
+      } catch (const std::exception& e) {
+        NODELET_ERROR("%s", e.what());
+      }
+    }
+    ros::requestShutdown();
+  }
+
+  RoadSceneParams scene_;
+  std::unique_ptr<VehicleCoSim> sim_;
+  std::unique_ptr<ExchangeTerrainPort> terrain_;
+  std::unique_ptr<ExchangeDriverPort> driver_;
+  std::string world_frame_, map_frame_, base_frame_, result_file_;
+  double log_rate_ = 100.0, clock_rate_ = 100.0, max_rtf_ = 0.0, force_scale_ = 1e-4;
+  bool wait_for_recorder_ = true, shutdown_when_done_ = false;
+  long log_every_ = 1, clock_every_ = 1;
+  double next_progress_ = 1.0, next_body_markers_ = 0.0;
+  std::chrono::steady_clock::time_point wall0_;
+  Counted clock_, tf_, tf_static_, odom_, states_, wrenches_, command_, body_markers_, live_markers_, result_;
+  std::vector<Counted*> counted_;
+  boost::shared_ptr<const WheelStates> logged_req_;
+  boost::shared_ptr<const DriverCommand> logged_cmd_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace dem_mobility
+
+PLUGINLIB_EXPORT_CLASS(dem_mobility::VehicleNodelet, nodelet::Nodelet)
