@@ -18,3 +18,18 @@ catkin_package(
   CATKIN_DEPENDS roscpp nodelet std_msgs geometry_msgs nav_msgs visualization_msgs tf2_msgs rosgraph_msgs
     message_runtime
 )
+
+if(CATKIN_ENABLE_TESTING)
+  find_package(rostest REQUIRED)
+  find_package(roslaunch REQUIRED)
+  # every launch file parses and finds its packages and files
+  roslaunch_add_file_check(launch/road_slope.launch)
+  roslaunch_add_file_check(launch/replay.launch bag:=/tmp/run.bag)
+  roslaunch_add_file_check(launch/components/vehicle.launch)
+  roslaunch_add_file_check(launch/components/terrain.launch)
+  roslaunch_add_file_check(launch/components/driver.launch)
+  roslaunch_add_file_check(launch/components/recorder.launch bag:=/tmp/run.bag)
+  roslaunch_add_file_check(launch/bench/cosim_exchange.launch)
+  roslaunch_add_file_check(test/ros/road_scene.test)
+  add_rostest(test/ros/road_scene.test)
+endif()

@@ -1,17 +1,60 @@
 #!/usr/bin/env bash
 # Runs the benchmarks and prints one line per figure: NAME FIGURE VALUE UNIT.
-#   ./scripts/bench.sh            all benchmarks
-#   ./scripts/bench.sh vehicle_step
+#   ./scripts/bench.sh                  all benchmarks
+#   ./scripts/bench.sh vehicle_step     the 33-body vehicle's step on the road (core, no ROS)
+#   ./scripts/bench.sh cosim_exchange   round trip of the vehicle-terrain exchange between nodelets
+#   ./scripts/bench.sh road_scene       the 40 s road run end to end through ROS, with the bag
 source "$(dirname "$0")/lib.sh"
-ensure_packages "${DM_CORE_PACKAGES[@]}"
-build_core >/dev/null
 want="${1:-all}"
+case "$want" in all|vehicle_step|cosim_exchange|road_scene) ;; *)
+  echo "unknown benchmark '$want' (have: vehicle_step cosim_exchange road_scene)" >&2; exit 2 ;;
+esac
+ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}"
+build_core >/dev/null
+if [ "$want" != vehicle_step ]; then build_catkin >/dev/null; ros_env; fi
 echo "# $(date -u +%Y-%m-%dT%H:%MZ) $(uname -m) $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
-ran=0
-for b in vehicle_step; do
-  if [ "$want" = all ] || [ "$want" = "$b" ]; then
-    "$DM_BUILD/core/bench/${b}_bench"
-    ran=1
-  fi
-done
-[ "$ran" = 1 ] || { echo "unknown benchmark '$want' (have: vehicle_step)" >&2; exit 2; }
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+
+if [ "$want" = all ] || [ "$want" = vehicle_step ]; then
+  "$DM_BUILD/core/bench/vehicle_step_bench"
+fi
+
+if [ "$want" = all ] || [ "$want" = cosim_exchange ]; then
+  # label, launch arguments
+  variants=(
+    "one_manager_shared_memory_spin transport:=shared_memory spin:=5e-5 round_trips:=200000"
+    "one_manager_shared_memory_blocking transport:=shared_memory spin:=0 round_trips:=50000"
+    "one_manager_topics transport:=topics spin:=0 round_trips:=30000"
+    "separate_processes_topics standalone:=true spin:=0 round_trips:=20000"
+  )
+  for v in "${variants[@]}"; do
+    set -- $v
+    label="$1"; shift
+    roslaunch dem_mobility cosim_exchange.launch label:="$label" out:="$tmp/$label.yaml" "$@" >"$tmp/$label.log" 2>&1 || true
+    if [ -f "$tmp/$label.yaml" ]; then
+      echo "cosim_exchange ${label}_median $(yaml_get "$tmp/$label.yaml" median_us) us"
+      echo "cosim_exchange ${label}_p99 $(yaml_get "$tmp/$label.yaml" p99_us) us"
+    else
+      echo "cosim_exchange $label failed; log:" >&2; tail -20 "$tmp/$label.log" >&2; exit 1
+    fi
+  done
+fi
+
+if [ "$want" = all ] || [ "$want" = road_scene ]; then
+  # the paper's 40 s at the road's own step, logging at 100 Hz to a bag; then 5 s at the soil's step
+  for v in "road_dt auto 40" "dt_1.5e-5 1.5e-5 5"; do
+    set -- $v
+    roslaunch dem_mobility road_slope.launch bag:="$tmp/$1.bag" time_step:="$2" duration:="$3" >"$tmp/$1.log" 2>&1 || true
+    r="$tmp/$1.result.yaml"
+    if [ ! -f "$r" ] || [ "$(yaml_get "$r" status)" = error ]; then
+      echo "road_scene $1 failed; log:" >&2; tail -20 "$tmp/$1.log" >&2; exit 1
+    fi
+    echo "road_scene ${1}_time_step $(yaml_get "$r" time_step) s"
+    echo "road_scene ${1}_simulated $(python3 -c "import yaml,sys; d=yaml.safe_load(open(sys.argv[1])); print(round(d['steps']*d['time_step'],3))" "$r") s"
+    echo "road_scene ${1}_wall $(yaml_get "$r" wall_time) s"
+    echo "road_scene ${1}_real_time_factor $(yaml_get "$r" real_time_factor) x"
+    echo "road_scene ${1}_us_per_step $(python3 -c "import yaml,sys; d=yaml.safe_load(open(sys.argv[1])); print(round(1e6*d['wall_time']/d['steps'],2))" "$r") us"
+    echo "road_scene ${1}_bag_size $(du -m "$tmp/$1.bag" | cut -f1) MB"
+  done
+fi

@@ -12,7 +12,7 @@ DM_CORE_PACKAGES=(cmake g++ make libeigen3-dev libyaml-cpp-dev libgtest-dev libb
 DM_ROS_PACKAGES=(catkin ros-core-dev libroscpp-dev libnodeletlib-dev librosbag-dev libtf2-ros-dev
   libtf2-eigen-dev libnodeletlib-tools ros-geometry-msgs ros-sensor-msgs ros-visualization-msgs ros-message-generation
   ros-nav-msgs ros-rosgraph-msgs ros-tf2-msgs libtopic-tools-dev pluginlib-dev
-  python3-rosbag python3-roslaunch python3-rostest python3-catkin-pkg python3-matplotlib python3-yaml)
+  python3-rosbag python3-roslaunch python3-rostest python3-catkin-pkg python3-std-msgs python3-geometry-msgs python3-matplotlib python3-yaml)
 # only for the checks of the test command (package lint, rviz screenshot under Xvfb)
 DM_CHECK_PACKAGES=(catkin-lint rviz xvfb imagemagick)
 
@@ -53,3 +53,14 @@ build_catkin() {
     || { tail -40 "$DM_BUILD/catkin_make.log"; echo "catkin_make failed; full log: $DM_BUILD/catkin_make.log"; exit 1; }
   tail -3 "$DM_BUILD/catkin_make.log"
 }
+
+# The ROS environment of the catkin workspace (its setup scripts read unset variables).
+ros_env() {
+  set +u
+  # shellcheck disable=SC1091
+  source "$DM_WS/devel/setup.bash"
+  set -u
+}
+
+# Prints a result YAML's key (top level, scalar).
+yaml_get() { python3 -c 'import sys, yaml; print(yaml.safe_load(open(sys.argv[1]))[sys.argv[2]])' "$1" "$2"; }

@@ -25,6 +25,13 @@
 #include <boost/shared_ptr.hpp>
 #include <ros/ros.h>
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define DM_CPU_RELAX() _mm_pause()
+#else
+#define DM_CPU_RELAX() ((void)0)
+#endif
+
 namespace dem_mobility {
 
 /// A peer left, did not answer in time, or answered out of order.
@@ -56,6 +63,7 @@ class Mailbox {
       const auto spin_end = t0 + spin;
       int n = 0;
       while (!Ready() && !closed_.load(std::memory_order_acquire)) {
+        DM_CPU_RELAX();
         if ((++n & 63) == 0 && std::chrono::steady_clock::now() >= spin_end) break;
       }
     }
