@@ -16,6 +16,8 @@ class DriverNodelet : public nodelet::Nodelet {
  public:
   ~DriverNodelet() override {
     stop_ = true;
+    // the vehicle learns at once that its driver is gone (instead of after its timeout)
+    if (server_) server_->Leave("the driver nodelet was unloaded");
     if (thread_.joinable()) thread_.join();
   }
 
@@ -34,7 +36,14 @@ class DriverNodelet : public nodelet::Nodelet {
                    scene.driver.v_max, scene.driver.control_period, transport.c_str());
     } catch (const std::exception& e) {
       NODELET_FATAL("%s", e.what());
-      ros::requestShutdown();
+      // in one manager, the vehicle finds the channel closed with the reason and ends the run
+      // (writing its result); a standalone driver ends its process
+      if (pnh.param<std::string>("exchange_transport", "shared_memory") == "shared_memory") {
+        failed_ = ChannelRegistry::Get<DriverInput, DriverCommand>(nh.resolveName("exchange/driver"));
+        failed_->Close(std::string("the driver could not start: ") + e.what());
+      } else {
+        ros::requestShutdown();
+      }
       return;
     }
     thread_ = std::thread([this] { Serve(); });
@@ -68,6 +77,7 @@ class DriverNodelet : public nodelet::Nodelet {
 
   std::unique_ptr<SceneDriver> driver_;
   std::unique_ptr<ExchangeServer<DriverInput, DriverCommand>> server_;
+  std::shared_ptr<Channel<DriverInput, DriverCommand>> failed_;  ///< held closed when the setup failed
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };

@@ -17,6 +17,8 @@ class TerrainNodelet : public nodelet::Nodelet {
  public:
   ~TerrainNodelet() override {
     stop_ = true;
+    // the vehicle learns at once that its terrain is gone (instead of after its timeout)
+    if (server_) server_->Leave("the terrain nodelet was unloaded");
     if (thread_.joinable()) thread_.join();
   }
 
@@ -36,7 +38,14 @@ class TerrainNodelet : public nodelet::Nodelet {
                    scene.terrain_file.c_str(), model_->Surface().faces.size(), transport.c_str());
     } catch (const std::exception& e) {
       NODELET_FATAL("%s", e.what());
-      ros::requestShutdown();
+      // in one manager, the vehicle finds the channel closed with the reason and ends the run
+      // (writing its result); a standalone terrain ends its process
+      if (pnh.param<std::string>("exchange_transport", "shared_memory") == "shared_memory") {
+        failed_ = ChannelRegistry::Get<WheelStates, WheelWrenches>(nh.resolveName("exchange/terrain"));
+        failed_->Close(std::string("the terrain could not start: ") + e.what());
+      } else {
+        ros::requestShutdown();
+      }
       return;
     }
     markers_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/markers", 1, true);
@@ -124,6 +133,7 @@ class TerrainNodelet : public nodelet::Nodelet {
 
   std::unique_ptr<TerrainModel> model_;
   std::unique_ptr<ExchangeServer<WheelStates, WheelWrenches>> server_;
+  std::shared_ptr<Channel<WheelStates, WheelWrenches>> failed_;  ///< held closed when the setup failed
   ros::Publisher markers_;
   std::string frame_id_;
   std::atomic<bool> stop_{false};

@@ -104,6 +104,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
+    pnh.param<std::string>("result_file", result_file_, "");  // first: a bad scene is reported there too
     try {
       scene_ = LoadScene(nh);
       std::string transport;
@@ -115,7 +116,6 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       pnh.param("log_rate", log_rate, log_rate);
       pnh.param("clock_rate", clock_rate, clock_rate);
       pnh.param("max_real_time_factor", max_rtf_, 0.0);
-      pnh.param<std::string>("result_file", result_file_, "");
       pnh.param("wait_for_recorder", wait_for_recorder_, true);
       pnh.param("shutdown_when_done", shutdown_when_done_, false);
       pnh.param("force_scale", force_scale_, 1e-4);

@@ -127,7 +127,8 @@ struct Channel {
 };
 
 /// Process-wide registry of channels by name (the resolved exchange namespace). A channel lives
-/// while either side holds it; a name whose channel was closed gets a fresh one.
+/// while either side holds it (closed or not: a peer that failed to start holds its channel closed,
+/// with the reason, for the other side to find); once neither does, the name gets a fresh one.
 class ChannelRegistry {
  public:
   template <class Req, class Resp>
@@ -137,9 +138,7 @@ class ChannelRegistry {
     std::lock_guard<std::mutex> lock(mutex);
     auto it = channels.find(name);
     if (it != channels.end()) {
-      if (auto p = std::static_pointer_cast<Channel<Req, Resp>>(it->second.lock())) {
-        if (!p->requests.closed()) return p;
-      }
+      if (auto p = std::static_pointer_cast<Channel<Req, Resp>>(it->second.lock())) return p;
     }
     auto p = std::make_shared<Channel<Req, Resp>>();
     channels[name] = p;
@@ -255,6 +254,10 @@ class ExchangeServer {
     Channel<Req, Resp>& ch = channel_ ? *channel_ : *own_;
     ReqPtr req;
     for (;;) {
+      if (stop.load()) {
+        *why = "stopped";
+        return nullptr;
+      }
       switch (ch.requests.Take(Seconds(timing_.spin), std::chrono::milliseconds(100), &req)) {
         case Mailbox<Req>::Wait::kMessage:
           return req;
