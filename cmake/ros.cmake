@@ -1,7 +1,7 @@
 # The ROS layer: messages of the lock-step exchange and results, the nodelets (thin wrappers over
 # dm_core), launch files and ROS tests. The core (src/core) never sees any of this.
-find_package(catkin REQUIRED COMPONENTS roscpp nodelet pluginlib rosbag topic_tools std_msgs geometry_msgs nav_msgs
-  sensor_msgs visualization_msgs tf2_msgs rosgraph_msgs message_generation)
+find_package(catkin REQUIRED COMPONENTS geometry_msgs message_generation nav_msgs nodelet pluginlib rosbag
+  rosgraph_msgs roscpp std_msgs tf2_msgs topic_tools visualization_msgs)
 
 add_message_files(DIRECTORY msg FILES
   WheelStates.msg
@@ -14,10 +14,12 @@ generate_messages(DEPENDENCIES std_msgs geometry_msgs)
 
 catkin_package(
   INCLUDE_DIRS include
-  LIBRARIES dem_mobility_nodelets
-  CATKIN_DEPENDS roscpp nodelet std_msgs geometry_msgs nav_msgs visualization_msgs tf2_msgs rosgraph_msgs
-    message_runtime
+  LIBRARIES ${PROJECT_NAME}_nodelets
+  CATKIN_DEPENDS geometry_msgs message_runtime nav_msgs nodelet pluginlib rosbag rosgraph_msgs roscpp std_msgs
+    tf2_msgs topic_tools visualization_msgs
 )
+install(DIRECTORY include/${PROJECT_NAME}/ DESTINATION ${CATKIN_PACKAGE_INCLUDE_DESTINATION})
+catkin_install_python(PROGRAMS scripts/plot_speed.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)
   find_package(rostest REQUIRED)

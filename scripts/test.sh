@@ -1,10 +1,28 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs every test: the core GoogleTest suite with plain CMake
-# (no ROS), then the catkin build of the whole package (ROS layer, messages).
+# Installs what is missing, builds, and runs every test:
+#  1. the core GoogleTest suite with plain CMake (no ROS master),
+#  2. the catkin build of the whole package, then its catkin tests: roslaunch-check on every launch
+#     file and the rostest of the lock-step exchange (test/ros/road_scene.test),
+#  3. the end-to-end road runs through roslaunch (test/ros/test_road_runs.py),
+#  4. catkin_lint on the package (must report nothing).
 source "$(dirname "$0")/lib.sh"
-ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}"
+ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
 build_core
 say "test: core suite (ctest, no ROS master)"
 (cd "$DM_BUILD/core" && ctest --output-on-failure --timeout 600)
 build_catkin
+ros_env
+say "test: catkin tests (roslaunch-check, rostest)"
+(cd "$DM_WS" && catkin_make run_tests -j"$(nproc)" >"$DM_BUILD/run_tests.log" 2>&1) || true
+if ! catkin_test_results --verbose "$DM_WS/build/test_results/dem_mobility"; then
+  tail -60 "$DM_BUILD/run_tests.log"
+  echo "catkin tests failed; full log: $DM_BUILD/run_tests.log"
+  exit 1
+fi
+say "test: end-to-end road runs through roslaunch"
+DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 "$DM_ROOT/test/ros/test_road_runs.py"
+say "test: catkin_lint"
+lint=$(cd "$DM_WS/src" && catkin_lint dem_mobility 2>&1 | grep -v rosdep)
+echo "$lint"
+echo "$lint" | grep -q "found 0 problems" || { echo "catkin_lint reported problems"; exit 1; }
 say "test: all passed"

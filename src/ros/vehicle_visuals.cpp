@@ -187,7 +187,7 @@ visualization_msgs::MarkerArray LiveMarkers(const VehicleCoSim& sim, const ros::
   joints.color = Color(0.95f, 0.95f, 0.2f);
   for (const PointJoint& j : sys.point_joints) {
     for (const auto& [body, r] : {std::make_pair(j.a, j.ra), std::make_pair(j.b, j.rb)}) {
-      if (body == 0) continue;
+      if (body == 0 || body == v.chassis()) continue;  // the chassis mounts would hide the rest
       const RigidBody& b = sys.body(body);
       joints.points.push_back(P(b.x));
       joints.points.push_back(P(b.PointWorld(r)));
