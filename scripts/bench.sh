@@ -23,6 +23,7 @@ fi
 if [ "$want" = all ] || [ "$want" = cosim_exchange ]; then
   # label, launch arguments
   variants=(
+    "one_manager_inline transport:=inline spin:=0 round_trips:=200000"
     "one_manager_shared_memory_spin transport:=shared_memory spin:=5e-5 round_trips:=200000"
     "one_manager_shared_memory_blocking transport:=shared_memory spin:=0 round_trips:=50000"
     "one_manager_topics transport:=topics spin:=0 round_trips:=30000"

@@ -158,13 +158,13 @@ RoadSceneParams LoadScene(const ros::NodeHandle& nh) {
 
 ExchangeTiming LoadExchangeTiming(const ros::NodeHandle& pnh, std::string* transport) {
   ExchangeTiming t;
-  pnh.param<std::string>("exchange_transport", *transport, "shared_memory");
+  pnh.param<std::string>("exchange_transport", *transport, "inline");
   pnh.param("exchange_spin", t.spin, t.spin);
   pnh.param("peer_timeout", t.peer_timeout, t.peer_timeout);
   pnh.param("startup_timeout", t.startup_timeout, t.startup_timeout);
-  if (*transport != "shared_memory" && *transport != "topics")
+  if (*transport != "inline" && *transport != "shared_memory" && *transport != "topics")
     throw ConfigError("parameter " + pnh.resolveName("exchange_transport") + ": '" + *transport +
-                      "' is not a transport (shared_memory or topics)");
+                      "' is not a transport (inline, shared_memory or topics)");
   if (!(t.spin >= 0.0 && t.spin <= 1.0)) throw ConfigError("parameter " + pnh.resolveName("exchange_spin") + " must be in [0, 1] s");
   if (!(t.peer_timeout > 0.0)) throw ConfigError("parameter " + pnh.resolveName("peer_timeout") + " must be positive");
   if (!(t.startup_timeout > 0.0)) throw ConfigError("parameter " + pnh.resolveName("startup_timeout") + " must be positive");

@@ -19,6 +19,7 @@ class DriverNodelet : public nodelet::Nodelet {
     // the vehicle learns at once that its driver is gone (instead of after its timeout)
     if (server_) server_->Leave("the driver nodelet was unloaded");
     if (thread_.joinable()) thread_.join();
+    if (served_ > 0) NODELET_INFO("driver: %lu commands given", static_cast<unsigned long>(served_));
   }
 
  private:
@@ -38,7 +39,7 @@ class DriverNodelet : public nodelet::Nodelet {
       NODELET_FATAL("%s", e.what());
       // in one manager, the vehicle finds the channel closed with the reason and ends the run
       // (writing its result); a standalone driver ends its process
-      if (pnh.param<std::string>("exchange_transport", "shared_memory") == "shared_memory") {
+      if (pnh.param<std::string>("exchange_transport", "inline") != "topics") {
         failed_ = ChannelRegistry::Get<DriverInput, DriverCommand>(nh.resolveName("exchange/driver"));
         failed_->Close(std::string("the driver could not start: ") + e.what());
       } else {
@@ -46,28 +47,40 @@ class DriverNodelet : public nodelet::Nodelet {
       }
       return;
     }
-    thread_ = std::thread([this] { Serve(); });
+    if (!server_->ServeInline([this](const DriverInput::ConstPtr& req) { return AnswerInline(req); }))
+      thread_ = std::thread([this] { Serve(); });
+  }
+
+  /// The driver's command for one control step.
+  DriverCommand::ConstPtr Answer(const DriverInput& req) {
+    const long step = static_cast<long>(req.step);
+    DM_THROW_UNLESS(step > last_step_, "driver input of step ", step, " after step ", last_step_,
+                    ": the lock-step order is broken");
+    const DriveCommand c = driver_->Exchange(FromMsg(req));
+    auto resp = boost::make_shared<DriverCommand>();
+    resp->header = req.header;
+    resp->step = req.step;
+    ToMsg(c, resp.get());
+    ++served_;
+    last_step_ = step;
+    return resp;
+  }
+
+  DriverCommand::ConstPtr AnswerInline(const DriverInput::ConstPtr& req) {
+    try {
+      return Answer(*req);
+    } catch (const std::exception& e) {
+      NODELET_ERROR("driver: %s", e.what());
+      server_->LeaveFromHandler(std::string("the driver failed: ") + e.what());
+      return nullptr;
+    }
   }
 
   void Serve() {
-    uint64_t served = 0;
-    long last_step = -1;
     std::string why;
     try {
-      while (auto req = server_->Wait(stop_, &why)) {
-        const long step = static_cast<long>(req->step);
-        DM_THROW_UNLESS(step > last_step, "driver input of step ", step, " after step ", last_step,
-                        ": the lock-step order is broken");
-        const DriveCommand c = driver_->Exchange(FromMsg(*req));
-        auto resp = boost::make_shared<DriverCommand>();
-        resp->header = req->header;
-        resp->step = req->step;
-        ToMsg(c, resp.get());
-        server_->Reply(resp);
-        ++served;
-        last_step = step;
-      }
-      NODELET_INFO("driver: %lu commands given; the exchange ended (%s)", static_cast<unsigned long>(served),
+      while (auto req = server_->Wait(stop_, &why)) server_->Reply(Answer(*req));
+      NODELET_INFO("driver: %lu commands given; the exchange ended (%s)", static_cast<unsigned long>(served_),
                    why.c_str());
     } catch (const std::exception& e) {
       NODELET_ERROR("driver: %s", e.what());
@@ -78,6 +91,8 @@ class DriverNodelet : public nodelet::Nodelet {
   std::unique_ptr<SceneDriver> driver_;
   std::unique_ptr<ExchangeServer<DriverInput, DriverCommand>> server_;
   std::shared_ptr<Channel<DriverInput, DriverCommand>> failed_;  ///< held closed when the setup failed
+  uint64_t served_ = 0;
+  long last_step_ = -1;
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };

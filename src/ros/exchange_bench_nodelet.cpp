@@ -44,7 +44,8 @@ class ExchangeBenchNodelet : public nodelet::Nodelet {
     } else if (role == "server") {
       server_ = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
           nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches", timing);
-      thread_ = std::thread([this] { Server(); });
+      if (!server_->ServeInline([this](const WheelStates::ConstPtr& req) { return Answer(*req); }))
+        thread_ = std::thread([this] { Server(); });
     } else {
       NODELET_FATAL("parameter %s must be client or server", pnh.resolveName("role").c_str());
       ros::requestShutdown();
@@ -84,22 +85,24 @@ class ExchangeBenchNodelet : public nodelet::Nodelet {
     ros::requestShutdown();
   }
 
+  WheelWrenches::ConstPtr Answer(const WheelStates& req) {
+    auto resp = boost::make_shared<WheelWrenches>();
+    resp->header = req.header;
+    resp->step = req.step;
+    resp->served = ++served_;
+    ToMsg(wrenches_, resp.get());
+    return resp;
+  }
+
   void Server() {
     std::string why;
-    std::vector<WheelWrench> w(4);
-    uint64_t served = 0;
-    while (auto req = server_->Wait(stop_, &why)) {
-      auto resp = boost::make_shared<WheelWrenches>();
-      resp->header = req->header;
-      resp->step = req->step;
-      resp->served = ++served;
-      ToMsg(w, resp.get());
-      server_->Reply(resp);
-    }
+    while (auto req = server_->Wait(stop_, &why)) server_->Reply(Answer(*req));
   }
 
   std::unique_ptr<ExchangeClient<WheelStates, WheelWrenches>> client_;
   std::unique_ptr<ExchangeServer<WheelStates, WheelWrenches>> server_;
+  std::vector<WheelWrench> wrenches_ = std::vector<WheelWrench>(4);
+  uint64_t served_ = 0;
   int round_trips_ = 0, warmup_ = 0;
   double spin_ = 0.0;
   std::string out_, label_, transport_;

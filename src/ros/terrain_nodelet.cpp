@@ -20,6 +20,7 @@ class TerrainNodelet : public nodelet::Nodelet {
     // the vehicle learns at once that its terrain is gone (instead of after its timeout)
     if (server_) server_->Leave("the terrain nodelet was unloaded");
     if (thread_.joinable()) thread_.join();
+    if (served_ > 0) NODELET_INFO("terrain: %lu exchanges answered", static_cast<unsigned long>(served_));
   }
 
  private:
@@ -40,7 +41,7 @@ class TerrainNodelet : public nodelet::Nodelet {
       NODELET_FATAL("%s", e.what());
       // in one manager, the vehicle finds the channel closed with the reason and ends the run
       // (writing its result); a standalone terrain ends its process
-      if (pnh.param<std::string>("exchange_transport", "shared_memory") == "shared_memory") {
+      if (pnh.param<std::string>("exchange_transport", "inline") != "topics") {
         failed_ = ChannelRegistry::Get<WheelStates, WheelWrenches>(nh.resolveName("exchange/terrain"));
         failed_->Close(std::string("the terrain could not start: ") + e.what());
       } else {
@@ -50,32 +51,43 @@ class TerrainNodelet : public nodelet::Nodelet {
     }
     markers_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/markers", 1, true);
     PublishSurface();
-    thread_ = std::thread([this] { Serve(); });
+    // inline: the vehicle's thread runs Answer; otherwise this nodelet's own thread does
+    if (!server_->ServeInline([this](const WheelStates::ConstPtr& req) { return AnswerInline(req); }))
+      thread_ = std::thread([this] { Serve(); });
+  }
+
+  /// The wrenches of one exchange (the model's, converted).
+  WheelWrenches::ConstPtr Answer(const WheelStates& req) {
+    const long step = static_cast<long>(req.step);
+    DM_THROW_UNLESS(step > last_step_, "wheel states of step ", step, " after step ", last_step_,
+                    ": the lock-step order is broken");
+    FromMsg(req, &states_);
+    model_->Compute(step, req.header.stamp.toSec(), states_, &wrenches_);
+    auto resp = boost::make_shared<WheelWrenches>();
+    resp->header.stamp = req.header.stamp;
+    resp->header.frame_id = req.header.frame_id;
+    resp->step = req.step;
+    resp->served = ++served_;
+    ToMsg(wrenches_, resp.get());
+    last_step_ = step;
+    return resp;
+  }
+
+  WheelWrenches::ConstPtr AnswerInline(const WheelStates::ConstPtr& req) {
+    try {
+      return Answer(*req);
+    } catch (const std::exception& e) {
+      NODELET_ERROR("terrain: %s", e.what());
+      server_->LeaveFromHandler(std::string("the terrain failed: ") + e.what());
+      return nullptr;
+    }
   }
 
   void Serve() {
-    std::vector<WheelState> states;
-    std::vector<WheelWrench> wrenches;
-    uint64_t served = 0;
-    long last_step = -1;
     std::string why;
     try {
-      while (auto req = server_->Wait(stop_, &why)) {
-        const long step = static_cast<long>(req->step);
-        DM_THROW_UNLESS(step > last_step, "wheel states of step ", step, " after step ", last_step,
-                        ": the lock-step order is broken");
-        FromMsg(*req, &states);
-        model_->Compute(step, req->header.stamp.toSec(), states, &wrenches);
-        auto resp = boost::make_shared<WheelWrenches>();
-        resp->header.stamp = req->header.stamp;
-        resp->header.frame_id = req->header.frame_id;
-        resp->step = req->step;
-        resp->served = ++served;
-        ToMsg(wrenches, resp.get());
-        server_->Reply(resp);
-        last_step = step;
-      }
-      NODELET_INFO("terrain: %lu exchanges answered; the exchange ended (%s)", static_cast<unsigned long>(served),
+      while (auto req = server_->Wait(stop_, &why)) server_->Reply(Answer(*req));
+      NODELET_INFO("terrain: %lu exchanges answered; the exchange ended (%s)", static_cast<unsigned long>(served_),
                    why.c_str());
     } catch (const std::exception& e) {
       NODELET_ERROR("terrain: %s", e.what());
@@ -136,6 +148,10 @@ class TerrainNodelet : public nodelet::Nodelet {
   std::shared_ptr<Channel<WheelStates, WheelWrenches>> failed_;  ///< held closed when the setup failed
   ros::Publisher markers_;
   std::string frame_id_;
+  std::vector<WheelState> states_;
+  std::vector<WheelWrench> wrenches_;
+  uint64_t served_ = 0;
+  long last_step_ = -1;
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };

@@ -2,8 +2,9 @@
 """End-to-end runs of the road scene through roslaunch, as a user starts it (each run gets its own
 master). Checks what one run cannot: the same scene twice gives the same messages; the vehicle
 follows the commanded 1 m/s^2 while torque allows; the nodelet run gives the in-process core
-runner's numbers exactly; a terrain process killed mid-run stops the run with a clear error after
-the peer timeout instead of a hang; bad input is refused with the file and key.
+runner's numbers exactly; a terrain nodelet unloaded from the manager mid-run, or a terrain
+process killed mid-run, stops the run with a clear error instead of a hang; bad input is refused
+with the file and key.
 
     python3 test/ros/test_road_runs.py   (after the catkin build; needs the workspace sourced)
 """
@@ -138,13 +139,40 @@ class Failures(unittest.TestCase):
         shutil.rmtree(self.tmp, ignore_errors=True)
 
     def wait_for_progress(self, run, timeout=60):
+        # the bag grows once the run is stepping (the console output reaches the log file in blocks)
         deadline = time.time() + timeout
-        while 'real-time factor' not in run.output():
+        while not (os.path.exists(run.bag) and os.path.getsize(run.bag) > 2e6):
             self.assertLess(time.time(), deadline, 'the run did not start: ' + run.output()[-2000:])
             time.sleep(0.2)
 
+    def test_unloaded_terrain_nodelet_stops_the_run_with_an_error(self):
+        run = Run(self.tmp, 'unload', 'duration:=300')
+        self.wait_for_progress(run)
+        said = ''
+        for _ in range(5):
+            # its own session: the nodelet tool signals its process group when it gives up
+            try:
+                u = subprocess.run(['/usr/lib/nodelet/nodelet', 'unload', NS + 'terrain', NS + 'manager',
+                                    '__name:=dm_test_unloader'], env=run.env, capture_output=True, text=True,
+                                   timeout=20, start_new_session=True, stdin=subprocess.DEVNULL)
+            except subprocess.TimeoutExpired as e:
+                self.fail('nodelet unload hung: %s %s\n%s' % (e.stdout, e.stderr, run.output()[-3000:]))
+            said += u.stdout + u.stderr
+            if u.returncode == 0:
+                break
+            time.sleep(2)
+        self.assertEqual(u.returncode, 0, said)
+        run.wait(60)
+        r = run.result()
+        self.assertEqual(r['status'], 'error', run.output()[-3000:])
+        self.assertIn('the terrain left the exchange', r['error'])
+        self.assertIn('unloaded', r['error'])
+        self.assertGreater(r['steps'], 0)
+        # the bag up to the failure is kept and readable
+        self.assertGreater(len(run.messages([NS + 'odom'])), 10)
+
     def test_killed_terrain_process_stops_the_run_after_the_peer_timeout(self):
-        run = Run(self.tmp, 'kill', 'duration:=60', 'standalone:=true', 'peer_timeout:=3')
+        run = Run(self.tmp, 'kill', 'duration:=300', 'standalone:=true', 'peer_timeout:=3')
         self.wait_for_progress(run, 90)
         pids = subprocess.run(['pgrep', '-f', 'standalone dem_mobility/TerrainNodelet.*' + run.dir],
                               capture_output=True, text=True).stdout.split()

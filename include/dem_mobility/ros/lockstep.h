@@ -1,6 +1,10 @@
 // The lock-step exchange between nodelets: a request/response pair of messages per step.
 //
-// Two transports behind one interface:
+// Three transports behind one interface:
+//  - "inline" (the default in one manager): both nodelets meet in a named Channel; the answering
+//    nodelet registers its handler there and the asking nodelet's thread runs it, so a step never
+//    changes threads: no hand-off, no spinning, and the other cores stay free (the bag recorder,
+//    rviz, the soil's OpenMP threads). The messages are the same zero-copy shared pointers.
 //  - "shared_memory": both nodelets in one manager (one process) meet in a named Channel; messages
 //    pass as shared pointers (zero copy) through single-slot mailboxes. A waiting side spins for a
 //    short time (the peer's step is usually shorter than a thread wake-up) and then blocks on a
@@ -15,6 +19,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -108,10 +113,15 @@ struct ExchangeTiming {
 /// The meeting point of two nodelets of one process: requests one way, responses the other.
 template <class Req, class Resp>
 struct Channel {
+  using Handler = std::function<boost::shared_ptr<const Resp>(const boost::shared_ptr<const Req>&)>;
   Mailbox<Req> requests;
   Mailbox<Resp> responses;
   std::mutex mutex;
   std::string closed_by;  ///< who closed it and why
+  /// inline transport: the answering side's handler, run under handler_mutex (so that a side
+  /// leaving waits for a call in progress and no call starts after it left)
+  std::mutex handler_mutex;
+  Handler handler;
   void Close(const std::string& why) {
     {
       std::lock_guard<std::mutex> lock(mutex);
@@ -119,10 +129,21 @@ struct Channel {
     }
     requests.Close();
     responses.Close();
+    std::lock_guard<std::mutex> lock(handler_mutex);
+    handler = nullptr;
   }
   std::string why() {
     std::lock_guard<std::mutex> lock(mutex);
     return closed_by;
+  }
+  /// Closes the channel from inside an inline handler (which holds handler_mutex).
+  void CloseFromHandler(const std::string& why) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (closed_by.empty()) closed_by = why;
+    }
+    requests.Close();
+    responses.Close();
   }
 };
 
@@ -161,8 +182,8 @@ class ExchangeClient {
   ExchangeClient(ros::NodeHandle nh, const std::string& transport, const std::string& name,
                  const std::string& req_topic, const std::string& resp_topic, const std::string& peer,
                  const ExchangeTiming& timing)
-      : peer_(peer), timing_(timing) {
-    if (transport == "shared_memory") {
+      : peer_(peer), timing_(timing), inline_(transport == "inline") {
+    if (transport == "shared_memory" || transport == "inline") {
       channel_ = ChannelRegistry::Get<Req, Resp>(name);
     } else if (transport == "topics") {
       own_ = std::make_shared<Channel<Req, Resp>>();
@@ -171,13 +192,14 @@ class ExchangeClient {
       sub_ = nh.subscribe<Resp>(resp_topic, 1, [ch](const RespPtr& m) { ch->responses.Put(m); },
                                 ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
     } else {
-      throw std::invalid_argument("exchange transport '" + transport + "': use shared_memory or topics");
+      throw std::invalid_argument("exchange transport '" + transport + "': use inline, shared_memory or topics");
     }
   }
   ~ExchangeClient() { Leave("the " + peer_ + "'s client left"); }
 
   /// Sends `req` (step `step`) and waits for the answer to it.
   RespPtr Call(const ReqPtr& req, uint64_t step) {
+    if (inline_) return CallInline(req, step);
     Channel<Req, Resp>& ch = channel_ ? *channel_ : *own_;
     if (channel_) {
       ch.requests.Put(req);
@@ -209,6 +231,37 @@ class ExchangeClient {
   }
 
  private:
+  RespPtr CallInline(const ReqPtr& req, uint64_t step) {
+    Channel<Req, Resp>& ch = *channel_;
+    const auto end = std::chrono::steady_clock::now() + Seconds(first_ ? timing_.startup_timeout : timing_.peer_timeout);
+    RespPtr resp;
+    for (;;) {
+      bool closed = false;
+      {
+        std::lock_guard<std::mutex> lock(ch.handler_mutex);
+        closed = ch.requests.closed();
+        if (!closed && ch.handler) {
+          resp = ch.handler(req);
+          break;
+        }
+      }
+      if (closed)
+        throw ExchangeError("the " + peer_ + " left the exchange at step " + std::to_string(step) + " (" + ch.why() +
+                            ")");
+      if (std::chrono::steady_clock::now() > end || !ros::ok())
+        throw ExchangeError("the " + peer_ + " did not answer step " + std::to_string(step) +
+                            " (is its nodelet loaded in this manager?)");
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));  // not there yet (still loading)
+    }
+    if (!resp)
+      throw ExchangeError("the " + peer_ + " could not answer step " + std::to_string(step) + " (" + ch.why() + ")");
+    if (resp->step != step)
+      throw ExchangeError("the " + peer_ + " answered step " + std::to_string(resp->step) + " to step " +
+                          std::to_string(step) + ": the lock-step order is broken");
+    first_ = false;
+    return resp;
+  }
+
   void WaitForSubscriber() {
     const auto end = std::chrono::steady_clock::now() + Seconds(timing_.startup_timeout);
     while (pub_.getNumSubscribers() == 0 || sub_.getNumPublishers() == 0) {
@@ -220,6 +273,7 @@ class ExchangeClient {
   }
   std::string peer_;
   ExchangeTiming timing_;
+  bool inline_ = false;
   std::shared_ptr<Channel<Req, Resp>> channel_, own_;
   ros::Publisher pub_;
   ros::Subscriber sub_;
@@ -234,8 +288,8 @@ class ExchangeServer {
   using RespPtr = boost::shared_ptr<const Resp>;
   ExchangeServer(ros::NodeHandle nh, const std::string& transport, const std::string& name,
                  const std::string& req_topic, const std::string& resp_topic, const ExchangeTiming& timing)
-      : timing_(timing) {
-    if (transport == "shared_memory") {
+      : timing_(timing), inline_(transport == "inline") {
+    if (transport == "shared_memory" || transport == "inline") {
       channel_ = ChannelRegistry::Get<Req, Resp>(name);
     } else if (transport == "topics") {
       own_ = std::make_shared<Channel<Req, Resp>>();
@@ -244,11 +298,24 @@ class ExchangeServer {
       sub_ = nh.subscribe<Req>(req_topic, 1, [ch](const ReqPtr& m) { ch->requests.Put(m); }, ros::VoidConstPtr(),
                                ros::TransportHints().tcpNoDelay());
     } else {
-      throw std::invalid_argument("exchange transport '" + transport + "': use shared_memory or topics");
+      throw std::invalid_argument("exchange transport '" + transport + "': use inline, shared_memory or topics");
     }
   }
   ~ExchangeServer() { Leave("the server left"); }
 
+  /// With the inline transport the client's thread runs `handler` for every request (a null
+  /// answer means the handler failed and left the exchange); returns false for other transports,
+  /// whose requests come through Wait.
+  /// Leaves from inside the inline handler.
+  void LeaveFromHandler(const std::string& why) {
+    if (channel_) channel_->CloseFromHandler(why);
+  }
+  bool ServeInline(typename Channel<Req, Resp>::Handler handler) {
+    if (!inline_) return false;
+    std::lock_guard<std::mutex> lock(channel_->handler_mutex);
+    if (!channel_->requests.closed()) channel_->handler = std::move(handler);
+    return true;
+  }
   /// The next request, or null when the client left (`why` tells) or `stop` was set.
   ReqPtr Wait(const std::atomic<bool>& stop, std::string* why) {
     Channel<Req, Resp>& ch = channel_ ? *channel_ : *own_;
@@ -282,6 +349,7 @@ class ExchangeServer {
 
  private:
   ExchangeTiming timing_;
+  bool inline_ = false;
   std::shared_ptr<Channel<Req, Resp>> channel_, own_;
   ros::Publisher pub_;
   ros::Subscriber sub_;
