@@ -43,10 +43,12 @@ if [ "$want" = all ] || [ "$want" = cosim_exchange ]; then
 fi
 
 if [ "$want" = all ] || [ "$want" = road_scene ]; then
-  # the paper's 40 s at the road's own step, logging at 100 Hz to a bag; then 5 s at the soil's step
-  for v in "road_dt auto 40" "dt_1.5e-5 1.5e-5 5"; do
+  # the paper's 40 s at the road's own step, logging at 100 Hz to a bag; 5 s at the soil's step;
+  # 2 s with every nodelet in its own process (exchange over topics)
+  for v in "road_dt auto 40 false" "dt_1.5e-5 1.5e-5 5 false" "separate_processes auto 2 true"; do
     set -- $v
-    roslaunch dem_mobility road_slope.launch bag:="$tmp/$1.bag" time_step:="$2" duration:="$3" >"$tmp/$1.log" 2>&1 || true
+    roslaunch dem_mobility road_slope.launch bag:="$tmp/$1.bag" time_step:="$2" duration:="$3" standalone:="$4" \
+      >"$tmp/$1.log" 2>&1 || true
     r="$tmp/$1.result.yaml"
     if [ ! -f "$r" ] || [ "$(yaml_get "$r" status)" = error ]; then
       echo "road_scene $1 failed; log:" >&2; tail -20 "$tmp/$1.log" >&2; exit 1

@@ -74,6 +74,7 @@ class BagRecorderNodelet : public nodelet::Nodelet {
   struct Topic {
     std::string name;     ///< resolved
     bool stream = false;  ///< gates the ordering (publishes all run long)
+    bool latched = false; ///< replayed latched (rosbag play honours the flag), so a late rviz sees it
     int stamp_offset = -2;///< -2: not yet known
     ros::Time latest;     ///< newest stamp received
     bool seen = false;
@@ -91,6 +92,8 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     if (!pnh.getParam("topics", topics) || topics.empty())
       return Fatal("parameter " + pnh.resolveName("topics") + " (the list of topics to record) is not set");
     pnh.getParam("stream_topics", stream);
+    std::vector<std::string> latched;
+    pnh.getParam("latched_topics", latched);
     pnh.param<std::string>("end_topic", end, "");
     pnh.param("shutdown_when_done", shutdown_when_done_, false);
     try {
@@ -106,6 +109,7 @@ class BagRecorderNodelet : public nodelet::Nodelet {
       Topic& t = topics_[i];
       t.name = nh.resolveName(topics[i]);
       t.stream = std::find(stream.begin(), stream.end(), topics[i]) != stream.end();
+      t.latched = std::find(latched.begin(), latched.end(), topics[i]) != latched.end();
       if (topics[i] == end) end_index_ = static_cast<int>(i);
     }
     for (const std::string& s : stream)
@@ -154,8 +158,7 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     (*header)["md5sum"] = msg->getMD5Sum();
     (*header)["message_definition"] = msg->getMessageDefinition();
     (*header)["callerid"] = event.getPublisherName();
-    const auto& in = event.getConnectionHeaderPtr();
-    (*header)["latching"] = in && in->count("latching") ? in->at("latching") : "0";
+    (*header)["latching"] = t.latched ? "1" : "0";
     t.queue.push_back({stamp, msg, header});
     ++t.count;
     if (t.stream) {

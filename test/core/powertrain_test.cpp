@@ -60,5 +60,33 @@ TEST(Driver, RequestsWotWhenTheCommandOutrunsTheVehicle) {
   EXPECT_GT(b.brake_effort, 0.0);
 }
 
+TEST(Driver, CommandIsClampedToTheTablesAtSeveralDriveShaftSpeeds) {
+  // the driver nodelet's SpeedDriver: far behind its command it gets the WOT row, far ahead the
+  // engine-brake row of powertrain.yaml, at each drive-shaft speed
+  const PowertrainParams p = Hmmwv();
+  DriverParams d;
+  d.kp = 5000;
+  d.ki = 500;
+  const struct {
+    double w, wot;
+  } wot_rows[] = {{20.0, 6424.0}, {125.0, 1885.0}, {350.0, 685.0}};
+  for (const auto& r : wot_rows) {
+    SpeedDriver drv(d, p, 4863.0, 0.485, 0.2);
+    const DriveCommand c = drv.Update(20.0, 1e-3, 0.0, r.w);
+    EXPECT_DOUBLE_EQ(c.drive_torque, r.wot) << "w = " << r.w;
+    EXPECT_TRUE(c.wot_limited);
+  }
+  const struct {
+    double w, eb;
+  } brake_rows[] = {{30.0, -176.0}, {300.0, -22.0}};
+  for (const auto& r : brake_rows) {
+    SpeedDriver drv(d, p, 4863.0, 0.485, 0.2);
+    const DriveCommand c = drv.Update(1.0, 1e-3, 20.0, r.w);
+    EXPECT_DOUBLE_EQ(c.drive_torque, r.eb) << "w = " << r.w;
+    EXPECT_FALSE(c.wot_limited);
+    EXPECT_GT(c.brake_effort, 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace dem_mobility
