@@ -86,6 +86,23 @@ TEST(Vehicle, AcceleratesAtTheCommandedRateWhileTorqueAllows) {
   EXPECT_NEAR((v8 - v3) / 5.0, 1.0, 0.03);
 }
 
+// A coupling interval of n exchanges with the terrain every n-th step and holds the wrenches in
+// between; at rest on the road the held wrenches still carry the weight.
+TEST(Vehicle, CouplingIntervalExchangesEveryNthStepAndHoldsTheWrenches) {
+  RoadSceneParams p = Scene(0.0);
+  p.coupling_interval = 4;
+  p.duration = 0.5;
+  RoadScene s(p);
+  const RoadResult r = s.Run();
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_EQ(r.exchanges, r.steps / 4 + 1);  // the opening exchange, then steps 4, 8, ...
+  EXPECT_EQ(s.sim().last_exchange_step(), r.steps - r.steps % 4);
+  const Vehicle& v = s.vehicle();
+  double total = 0;
+  for (int i = 0; i < 4; ++i) total += v.WheelLoad(i);
+  EXPECT_NEAR(total, v.system().TotalMass() * 9.81, 0.01 * v.system().TotalMass() * 9.81);
+}
+
 TEST(Vehicle, TimeStepAboveTheCriticalOneIsRefused) {
   RoadSceneParams p = Scene(0.0);
   RoadScene probe(p);
