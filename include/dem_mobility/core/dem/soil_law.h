@@ -1,0 +1,87 @@
+// The cohesive soil particle law of the paper's section 2.3: normal force = adhesion + repulsion +
+// damping (eq. 15, 12b; fig. 7), a per-particle plastic deformation that grows with the particle's
+// largest compressive force (fig. 8), is kept after unloading and relaxes at V_relax while the
+// compression is below the maximum adhesion (eq. 16), a maximum adhesion that grows with the
+// plastic strain (fig. 10, scaled by the cohesion factor f), and the asperity friction of eq. 13-14
+// (a Coulomb element in parallel with a variable-anchor spring, capped at mu F_repulsion).
+//
+// Sign convention: a penetration d > 0 means overlap; a normal force > 0 pushes the particles apart.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "dem_mobility/core/common/table.h"
+
+namespace dem_mobility {
+
+class YamlReader;
+
+struct SoilParams {
+  std::string file;
+  double diameter = 0.0;            ///< unstressed diameter d [m]
+  double density = 0.0;             ///< [kg/m^3]
+  double stiffness_stress = 0.0;    ///< repulsion stress per penetration strain [N/m^2]
+  double damping_area = 0.0;        ///< damping per unit area [N s/m^3]
+  double separation_factor = 0.0;   ///< s_n
+  double adhesion_depth = 0.0;      ///< d0 / d
+  double adhesion_peak = 0.0;       ///< penetration / d at the full adhesion
+  double friction = 0.0;            ///< mu
+  double tangential_stiffness_ratio = 0.0;
+  double slip_velocity = 0.0;       ///< [m/s]
+  double viscosity = 0.0;           ///< c_t [N s/m]
+  double cohesion_factor = 1.0;     ///< f
+  double relax_speed = 0.0;         ///< V_relax [m/s]
+  bool plasticity = true, cohesion = true;
+  Table1D plastic_strain_vs_stress;           ///< fig. 8
+  Table1D adhesion_stress_vs_plastic_strain;  ///< fig. 10 (nominal, f = 1)
+
+  /// Reads and checks a soil file (config/soils/*.yaml); ConfigError names file and key.
+  static SoilParams Read(const YamlReader& y);
+
+  // derived
+  double Area() const;          ///< pi d^2 / 4: the area stresses refer to
+  double Mass() const;          ///< rho pi d^3 / 6
+  double NormalStiffness() const { return stiffness_stress * Area() / diameter; }  ///< k_n [N/m]
+  double NormalDamping() const { return damping_area * Area(); }                    ///< c_n [N s/m]
+  double TangentialStiffness() const { return tangential_stiffness_ratio * NormalStiffness(); }
+};
+
+/// The parts of the normal force of one contact (eq. 15), each signed (> 0 repulsive).
+struct SoilNormalForce {
+  double adhesion = 0.0;   ///< <= 0
+  double repulsion = 0.0;  ///< >= 0
+  double damping = 0.0;
+  double Total() const { return adhesion + repulsion + damping; }
+};
+
+/// Normal force of a contact with effective penetration `d` (the geometric overlap less the plastic
+/// deformations of the two particles), penetration rate `d_dot` (> 0 approaching) and maximum
+/// adhesion `f_adh_max` [N] (fig. 7): for 0 < d < d0 attractive, rising to -f_adh_max at the peak
+/// penetration and back to 0 at d0; beyond d0 repulsive, k_n (d - d0). Damping c_n d_dot, times
+/// s_n while separating. No force for d <= 0.
+SoilNormalForce ComputeSoilNormalForce(const SoilParams& p, double d, double d_dot, double f_adh_max);
+
+/// Maximum adhesion force of a particle with plastic deformation `delta_p` [m]: f x fig. 10 at the
+/// plastic strain delta_p / d, times the area. 0 when cohesion is off.
+double MaxAdhesionForce(const SoilParams& p, double delta_p);
+
+/// One step of a particle's plastic deformation: grows to fig. 8 at the stress of its largest
+/// repulsive force (never shrinks from loading), and relaxes by V_relax dt, floored at zero, while
+/// that force is below the particle's maximum adhesion (eq. 16). Unchanged when plasticity is off.
+double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double dt);
+
+/// Tangential (history) state of a contact: the elongation of the anchor spring.
+struct TangentialHistory {
+  Eigen::Vector3d spring = Eigen::Vector3d::Zero();
+};
+
+/// Tangential force (eq. 13-14) of a contact with unit normal `n` (from the other body toward
+/// this one), relative tangential velocity `vt` (this body's contact point relative to the other's,
+/// in the tangent plane) and repulsive force `f_rep`; advances the anchor spring by vt dt, keeps it
+/// in the tangent plane and slides the anchor when the force exceeds mu f_rep. Returns the force on
+/// this body.
+Eigen::Vector3d ComputeSoilTangentialForce(const SoilParams& p, const Eigen::Vector3d& n, const Eigen::Vector3d& vt,
+                                           double f_rep, double dt, TangentialHistory* h);
+
+}  // namespace dem_mobility

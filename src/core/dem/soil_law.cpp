@@ -1,0 +1,98 @@
+#include "dem_mobility/core/dem/soil_law.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+
+namespace dem_mobility {
+
+SoilParams SoilParams::Read(const YamlReader& y) {
+  SoilParams p;
+  p.file = y.file();
+  p.diameter = y.DoubleIn("diameter", 1e-4, 1.0);
+  p.density = y.DoubleIn("density", 1.0, 2e4);
+  p.stiffness_stress = y.Positive("stiffness_stress");
+  p.damping_area = y.NonNegative("damping_area");
+  p.separation_factor = y.DoubleIn("separation_factor", 0.0, 1.0);
+  p.adhesion_depth = y.DoubleIn("adhesion_depth", 0.0, 0.2);
+  p.adhesion_peak = y.DoubleIn("adhesion_peak", 0.0, 0.2);
+  if (p.adhesion_depth > 0.0 && !(p.adhesion_peak > 0.0 && p.adhesion_peak < p.adhesion_depth))
+    y.Fail("adhesion_peak", "must lie strictly between 0 and adhesion_depth (" + detail::Concat(p.adhesion_depth) +
+                                "), found " + detail::Concat(p.adhesion_peak));
+  p.friction = y.DoubleIn("friction", 0.0, 5.0);
+  p.tangential_stiffness_ratio = y.DoubleIn("tangential_stiffness_ratio", 0.0, 2.0);
+  p.slip_velocity = y.Positive("slip_velocity");
+  p.viscosity = y.NonNegative("viscosity");
+  p.cohesion_factor = y.DoubleIn("cohesion_factor", 0.0, 100.0);
+  p.relax_speed = y.NonNegative("relax_speed");
+  p.plasticity = y.Bool("plasticity", true);
+  p.cohesion = y.Bool("cohesion", true);
+  p.plastic_strain_vs_stress = y.Table("plastic_strain_vs_stress");
+  p.adhesion_stress_vs_plastic_strain = y.Table("adhesion_stress_vs_plastic_strain");
+  for (double e : p.plastic_strain_vs_stress.y())
+    if (!(e >= 0.0 && e < 0.5)) y.Fail("plastic_strain_vs_stress", "plastic strains must lie in [0, 0.5)");
+  for (double s : p.adhesion_stress_vs_plastic_strain.y())
+    if (!(s >= 0.0)) y.Fail("adhesion_stress_vs_plastic_strain", "adhesion stresses must be >= 0");
+  y.Finish();
+  return p;
+}
+
+double SoilParams::Area() const { return 0.25 * M_PI * diameter * diameter; }
+double SoilParams::Mass() const { return density * M_PI * diameter * diameter * diameter / 6.0; }
+
+SoilNormalForce ComputeSoilNormalForce(const SoilParams& p, double d, double d_dot, double f_adh_max) {
+  SoilNormalForce f;
+  if (!(d > 0.0)) return f;
+  const double d0 = p.adhesion_depth * p.diameter;
+  if (p.cohesion && f_adh_max > 0.0 && d < d0) {
+    const double dp = p.adhesion_peak * p.diameter;
+    f.adhesion = d <= dp ? -f_adh_max * d / dp : -f_adh_max * (d0 - d) / (d0 - dp);
+  }
+  if (d > d0) f.repulsion = p.NormalStiffness() * (d - d0);
+  const double c = p.NormalDamping();
+  f.damping = d_dot >= 0.0 ? c * d_dot : p.separation_factor * c * d_dot;
+  return f;
+}
+
+double MaxAdhesionForce(const SoilParams& p, double delta_p) {
+  if (!p.cohesion) return 0.0;
+  return p.cohesion_factor * p.adhesion_stress_vs_plastic_strain(delta_p / p.diameter) * p.Area();
+}
+
+double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double dt) {
+  if (!p.plasticity) return delta_p;
+  const double target = p.plastic_strain_vs_stress(max_repulsion / p.Area()) * p.diameter;
+  if (target > delta_p) return target;  // loading beyond the history: the deformation grows (fig. 8)
+  if (max_repulsion < MaxAdhesionForce(p, delta_p))  // eq. 16
+    return std::max(0.0, delta_p - p.relax_speed * dt);
+  return delta_p;
+}
+
+Eigen::Vector3d ComputeSoilTangentialForce(const SoilParams& p, const Eigen::Vector3d& n, const Eigen::Vector3d& vt,
+                                           double f_rep, double dt, TangentialHistory* h) {
+  // keep the spring in the current tangent plane, with its length (the contact frame turns)
+  Eigen::Vector3d s = h->spring;
+  const double len = s.norm();
+  s -= s.dot(n) * n;
+  const double len_t = s.norm();
+  if (len_t > 0.0) s *= len / len_t;
+  s += vt * dt;
+  const double k_t = p.TangentialStiffness();
+  const double vt_norm = vt.norm();
+  Eigen::Vector3d f_c = Eigen::Vector3d::Zero();
+  if (vt_norm > 0.0) f_c = (-p.friction * f_rep * std::min(1.0, vt_norm / p.slip_velocity) / vt_norm) * vt;
+  Eigen::Vector3d f_t = -k_t * s + f_c;
+  const double limit = p.friction * std::max(0.0, f_rep);
+  const double ft_norm = f_t.norm();
+  if (ft_norm > limit) {
+    f_t = ft_norm > 0.0 ? Eigen::Vector3d(f_t * (limit / ft_norm)) : Eigen::Vector3d::Zero();
+    // slip: the anchor moves so that the spring carries what the Coulomb element does not
+    s = k_t > 0.0 ? Eigen::Vector3d(-(f_t - f_c) / k_t) : Eigen::Vector3d::Zero();
+  }
+  h->spring = s;
+  return f_t - p.viscosity * vt;
+}
+
+}  // namespace dem_mobility
