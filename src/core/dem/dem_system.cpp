@@ -1,0 +1,282 @@
+#include "dem_mobility/core/dem/dem_system.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/multibody/elements.h"
+
+namespace dem_mobility {
+
+using Eigen::Vector3d;
+
+DemSystem::DemSystem(const SoilParams& soil, const DemSettings& settings) : soil_(soil), settings_(settings) {
+  DM_THROW_UNLESS(settings.skin > 0.0 && settings.skin <= 1.0, "DEM skin ", settings.skin,
+                  " (fraction of the diameter) must lie in (0, 1]");
+  DM_THROW_UNLESS(settings.threads >= 1, "DEM threads ", settings.threads, " must be >= 1");
+  DM_THROW_UNLESS(settings.max_overlap > 0.0 && settings.max_overlap < 1.0, "DEM max_overlap ",
+                  settings.max_overlap, " must lie in (0, 1)");
+  mass_ = soil.Mass();
+  cutoff_ = soil.diameter * (1.0 + settings.skin);
+}
+
+int DemSystem::AddParticle(const Vector3d& x, const Vector3d& v) {
+  DM_THROW_UNLESS(x.allFinite() && v.allFinite(), "particle ", x_.size(), ": position and velocity must be finite");
+  x_.push_back(x);
+  v_.push_back(v);
+  f_.push_back(mass_ * gravity_);
+  x_built_.push_back(x);
+  plastic_.push_back(0.0);
+  adhesion_max_.push_back(MaxAdhesionForce(soil_, 0.0));
+  max_repulsion_.push_back(0.0);
+  overlap_.push_back(0.0);
+  rebuild_ = true;
+  return static_cast<int>(x_.size()) - 1;
+}
+
+DemStepLimit DemSystem::CriticalTimeStep() const {
+  // the stiffest branch (repulsion k_n or the anchor spring k_t; the adhesion ramp f_max / peak
+  // where it is stiffer) acting from every neighbour at once on one particle
+  const double z = settings_.max_coordination;
+  double k = std::max(soil_.NormalStiffness(), soil_.TangentialStiffness());
+  std::string branch = soil_.NormalStiffness() >= soil_.TangentialStiffness() ? "repulsion" : "tangential spring";
+  if (soil_.cohesion && soil_.adhesion_peak > 0.0) {
+    double s_max = 0.0;
+    for (double s : soil_.adhesion_stress_vs_plastic_strain.y()) s_max = std::max(s_max, s);
+    const double k_adh = soil_.cohesion_factor * s_max * soil_.Area() / (soil_.adhesion_peak * soil_.diameter);
+    if (k_adh > k) {
+      k = k_adh;
+      branch = "adhesion ramp";
+    }
+  }
+  const double omega = std::sqrt(z * k / mass_);
+  const double zeta = z * soil_.NormalDamping() / (2.0 * std::sqrt(z * k * mass_));
+  DemStepLimit lim;
+  lim.dt_crit = CriticalStep(omega, zeta);
+  lim.detail = detail::Concat(branch, " stiffness ", k, " N/m from ", settings_.max_coordination,
+                              " neighbours on a particle of ", mass_, " kg (damping ratio ", zeta, ")");
+  return lim;
+}
+
+void DemSystem::Finalize(double dt) {
+  const DemStepLimit lim = CriticalTimeStep();
+  DM_THROW_UNLESS(std::isfinite(dt) && dt > 0.0, "DEM time step ", dt, " s must be positive");
+  DM_THROW_UNLESS(dt <= lim.dt_crit, "DEM time step ", dt, " s is above the critical step ", lim.dt_crit, " s (",
+                  lim.detail, "); use dt <= ", lim.dt_crit, " s");
+  dt_ = dt;
+  finalized_ = true;
+  BuildNeighbours();
+  ComputeForces();
+}
+
+void DemSystem::BuildNeighbours() {
+  const int n = size();
+  // a uniform grid of cells one cutoff wide over the particles' bounding box
+  Vector3d lo = Vector3d::Constant(1e300), hi = -lo;
+  for (const Vector3d& x : x_) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  if (n == 0) lo = hi = Vector3d::Zero();
+  Eigen::Vector3i dims;
+  for (int a = 0; a < 3; ++a) dims[a] = std::max(1, static_cast<int>((hi[a] - lo[a]) / cutoff_) + 1);
+  const long ncell = static_cast<long>(dims.x()) * dims.y() * dims.z();
+  auto cell_of = [&](const Vector3d& x) {
+    Eigen::Vector3i c;
+    for (int a = 0; a < 3; ++a) c[a] = std::min(dims[a] - 1, static_cast<int>((x[a] - lo[a]) / cutoff_));
+    return c;
+  };
+  std::vector<int> cell_start(ncell + 1, 0), cell_particles(n), pc(n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3i c = cell_of(x_[i]);
+    pc[i] = (c.z() * dims.y() + c.y()) * dims.x() + c.x();
+    ++cell_start[pc[i] + 1];
+  }
+  for (long c = 0; c < ncell; ++c) cell_start[c + 1] += cell_start[c];
+  {
+    std::vector<int> fill(cell_start.begin(), cell_start.end() - 1);
+    for (int i = 0; i < n; ++i) cell_particles[fill[pc[i]]++] = i;  // ascending index within a cell
+  }
+  // each particle's neighbours within the cutoff, ascending, in two passes (count, fill)
+  const double cut2 = cutoff_ * cutoff_;
+  std::vector<std::vector<int>> found(n);
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3i c = cell_of(x_[i]);
+    std::vector<int>& out = found[i];
+    out.clear();
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int cx = c.x() + dx, cy = c.y() + dy, cz = c.z() + dz;
+          if (cx < 0 || cy < 0 || cz < 0 || cx >= dims.x() || cy >= dims.y() || cz >= dims.z()) continue;
+          const long cell = (static_cast<long>(cz) * dims.y() + cy) * dims.x() + cx;
+          for (int k = cell_start[cell]; k < cell_start[cell + 1]; ++k) {
+            const int j = cell_particles[k];
+            if (j != i && (x_[i] - x_[j]).squaredNorm() < cut2) out.push_back(j);
+          }
+        }
+    std::sort(out.begin(), out.end());
+  }
+  std::vector<int> start(n + 1, 0);
+  for (int i = 0; i < n; ++i) start[i + 1] = start[i] + static_cast<int>(found[i].size());
+  std::vector<int> nbr(start[n]);
+  std::vector<TangentialHistory> hist(start[n]);
+  std::vector<unsigned char> touching(start[n], 0);
+  const int old_n = static_cast<int>(nbr_start_.size()) - 1;
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+  for (int i = 0; i < n; ++i) {
+    // carry each surviving contact's history over (both lists ascending: a merge)
+    int o = i < old_n ? nbr_start_[i] : 0;
+    const int o_end = i < old_n ? nbr_start_[i + 1] : 0;
+    for (int k = start[i], m = 0; k < start[i + 1]; ++k, ++m) {
+      const int j = found[i][m];
+      nbr[k] = j;
+      while (o < o_end && nbr_[o] < j) ++o;
+      if (o < o_end && nbr_[o] == j) {
+        hist[k] = hist_[o];
+        touching[k] = touching_[o];
+      }
+    }
+    x_built_[i] = x_[i];
+  }
+  nbr_start_.swap(start);
+  nbr_.swap(nbr);
+  hist_.swap(hist);
+  touching_.swap(touching);
+  rebuild_ = false;
+  ++builds_;
+}
+
+void DemSystem::ComputeForces() {
+  const int n = size();
+  const double D = soil_.diameter, dt = dt_;
+  const Vector3d weight = mass_ * gravity_;
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+  for (int i = 0; i < n; ++i) {
+    Vector3d f = weight;
+    double max_rep = 0.0, max_overlap = 0.0;
+    for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
+      const int j = nbr_[k];
+      const Vector3d r = x_[i] - x_[j];
+      const double dist = r.norm();
+      // effective penetration: the overlap less both particles' plastic deformation (summed first,
+      // so that i and j compute it identically)
+      max_overlap = std::max(max_overlap, D - dist);
+      const double d = (D - dist) - (plastic_[i] + plastic_[j]);
+      if (!(d > 0.0) || dist <= 0.0) {
+        hist_[k] = TangentialHistory();
+        touching_[k] = 0;
+        continue;
+      }
+      const Vector3d nrm = r / dist;  // from j toward i
+      const Vector3d vr = v_[i] - v_[j];
+      const double vn = vr.dot(nrm);
+      const SoilNormalForce fn =
+          ComputeSoilNormalForce(soil_, d, -vn, std::min(adhesion_max_[i], adhesion_max_[j]));
+      const Vector3d vt = vr - vn * nrm;
+      const Vector3d ft = ComputeSoilTangentialForce(soil_, nrm, vt, fn.repulsion, dt, &hist_[k]);
+      f += fn.Total() * nrm + ft;
+      max_rep = std::max(max_rep, fn.repulsion);
+      touching_[k] = 1;
+    }
+    f_[i] = f;
+    max_repulsion_[i] = max_rep;
+    overlap_[i] = max_overlap;
+  }
+}
+
+void DemSystem::Step() {
+  DM_DEMAND(finalized_);
+  const int n = size();
+  const double h = 0.5 * dt_, half_skin = 0.5 * settings_.skin * soil_.diameter;
+  const double inv_m = 1.0 / mass_;
+  double max_disp2 = 0.0;
+#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(max : max_disp2)
+  for (int i = 0; i < n; ++i) {
+    v_[i] += h * inv_m * f_[i];
+    x_[i] += dt_ * v_[i];
+    max_disp2 = std::max(max_disp2, (x_[i] - x_built_[i]).squaredNorm());
+  }
+  time_ += dt_;
+  ++step_;
+  CheckState();
+  if (rebuild_ || max_disp2 > half_skin * half_skin) BuildNeighbours();
+  ComputeForces();
+  CheckOverlaps();
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+  for (int i = 0; i < n; ++i) {
+    v_[i] += h * inv_m * f_[i];
+    plastic_[i] = UpdatePlasticDeformation(soil_, plastic_[i], max_repulsion_[i], dt_);
+    adhesion_max_[i] = MaxAdhesionForce(soil_, plastic_[i]);
+  }
+}
+
+void DemSystem::CheckState() const {
+  const int n = size();
+  const double half_skin = 0.5 * settings_.skin * soil_.diameter;
+  for (int i = 0; i < n; ++i) {
+    if (!(x_[i].allFinite() && v_[i].allFinite()))
+      throw SimulationError(detail::Concat("DEM step ", step_, " (t = ", time_, " s): particle ", i,
+                                           " has a non-finite state (x = ", x_[i].transpose(), ", v = ",
+                                           v_[i].transpose(), "); the time step is too large or an input is NaN"));
+    const double move = v_[i].norm() * dt_;
+    if (move > half_skin)
+      throw SimulationError(detail::Concat("DEM step ", step_, " (t = ", time_, " s): particle ", i, " moved ", move,
+                                           " m in one step, more than half the skin (", half_skin,
+                                           " m); its speed is ", v_[i].norm(), " m/s"));
+  }
+}
+
+void DemSystem::CheckOverlaps() const {
+  const double D = soil_.diameter, limit = settings_.max_overlap * D;
+  for (int i = 0; i < size(); ++i)
+    if (overlap_[i] > limit || !f_[i].allFinite())
+      throw SimulationError(detail::Concat("DEM step ", step_, " (t = ", time_, " s): particle ", i,
+                                           !f_[i].allFinite() ? " has a non-finite force" : " overlaps a neighbour by ",
+                                           overlap_[i] / D, " of the diameter (limit ", settings_.max_overlap, ")"));
+}
+
+int DemSystem::contacts() const {
+  int c = 0;
+  for (unsigned char t : touching_) c += t;
+  return c / 2;
+}
+
+DemEnergy DemSystem::Energy() const {
+  DemEnergy e;
+  const double D = soil_.diameter, d0 = soil_.adhesion_depth * D, dp = soil_.adhesion_peak * D;
+  const double kn = soil_.NormalStiffness(), kt = soil_.TangentialStiffness();
+  for (int i = 0; i < size(); ++i) {
+    e.kinetic += 0.5 * mass_ * v_[i].squaredNorm();
+    e.gravitational -= mass_ * gravity_.dot(x_[i]);
+    for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
+      const int j = nbr_[k];
+      if (!touching_[k]) continue;
+      // each contact is listed twice: half of its energy from each side
+      const double d = (D - (x_[i] - x_[j]).norm()) - (plastic_[i] + plastic_[j]);
+      double u = 0.5 * kt * hist_[k].spring.squaredNorm();
+      if (d > d0) u += 0.5 * kn * (d - d0) * (d - d0);
+      const double fmax = std::min(adhesion_max_[i], adhesion_max_[j]);
+      if (soil_.cohesion && fmax > 0.0 && d > 0.0 && dp > 0.0) {
+        // potential of the adhesion triangle, zero out of contact: -(area from 0 to min(d, d0))
+        const double a = std::min(d, d0);
+        const double w = a <= dp ? 0.5 * fmax * a * a / dp
+                                 : 0.5 * fmax * dp + fmax * (a - dp) - 0.5 * fmax * (a - dp) * (a - dp) / (d0 - dp);
+        u -= w;
+      }
+      e.elastic += 0.5 * u;
+    }
+  }
+  return e;
+}
+
+Vector3d DemSystem::Momentum() const {
+  Vector3d p = Vector3d::Zero();
+  for (const Vector3d& v : v_) p += mass_ * v;
+  return p;
+}
+
+}  // namespace dem_mobility

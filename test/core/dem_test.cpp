@@ -1,0 +1,156 @@
+// The DEM solver: collisions against the analytic spring-dashpot, momentum, determinism across
+// thread counts, the time-step guard and the watchdogs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/dem/dem_system.h"
+
+namespace dem_mobility {
+namespace {
+
+using Eigen::Vector3d;
+
+SoilParams Nominal() { return SoilParams::Read(YamlReader::Load(DM_CONFIG_DIR "/soils/nominal_clay.yaml")); }
+
+// a plain linear spring-dashpot: no adhesion, no plasticity, no friction
+SoilParams Elastic(double damping_area) {
+  SoilParams p = Nominal();
+  p.cohesion = false;
+  p.plasticity = false;
+  p.adhesion_depth = p.adhesion_peak = 0.0;
+  p.friction = 0.0;
+  p.damping_area = damping_area;
+  p.separation_factor = 1.0;
+  return p;
+}
+
+// two particles meeting head-on at +-v0; returns the speed after they part
+double Collide(const SoilParams& p, double v0, double dt_fraction) {
+  DemSystem s(p, DemSettings());
+  s.set_gravity(Vector3d::Zero());
+  const double D = p.diameter;
+  s.AddParticle(Vector3d(-0.5 * D - 1e-4, 0, 0), Vector3d(v0, 0, 0));
+  s.AddParticle(Vector3d(0.5 * D + 1e-4, 0, 0), Vector3d(-v0, 0, 0));
+  const double m_eff = 0.5 * p.Mass(), k = p.NormalStiffness();
+  s.Finalize(dt_fraction * 2.0 * std::sqrt(m_eff / k));
+  for (int i = 0; i < 200000 && !(s.positions()[1].x() - s.positions()[0].x() > D + 2e-4); ++i) s.Step();
+  return s.velocities()[1].x();
+}
+
+TEST(Dem, UndampedHeadOnCollisionConservesEnergy) {
+  const double v0 = 0.5;
+  const double v1 = Collide(Elastic(0.0), v0, 0.02);
+  EXPECT_NEAR(v1, v0, 1e-3 * v0);  // rebounds with the speed it came in with
+}
+
+TEST(Dem, DampedHeadOnCollisionMatchesTheAnalyticRestitution) {
+  const SoilParams p = Elastic(2.1e4);  // table 2 damping
+  const double m_eff = 0.5 * p.Mass(), k = p.NormalStiffness(), c = p.NormalDamping();
+  const double zeta = c / (2.0 * std::sqrt(k * m_eff));
+  const double e = std::exp(-M_PI * zeta / std::sqrt(1.0 - zeta * zeta));
+  const double v0 = 0.5;
+  EXPECT_NEAR(Collide(p, v0, 0.02) / v0, e, 0.01 * e);
+}
+
+std::vector<Vector3d> Cluster(int n, unsigned seed, double spacing) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.04, 0.04);
+  const int side = static_cast<int>(std::ceil(std::cbrt(n)));
+  std::vector<Vector3d> x;
+  for (int i = 0; i < n; ++i)
+    x.emplace_back(spacing * (i % side + u(rng)), spacing * ((i / side) % side + u(rng)),
+                   spacing * (i / (side * side) + u(rng)));
+  return x;
+}
+
+// particles thrown together (no gravity, no walls): cohesion, plasticity and friction all on
+DemSystem Implosion(int n, int threads) {
+  DemSettings st;
+  st.threads = threads;
+  st.max_overlap = 0.2;
+  const SoilParams p = Nominal();
+  DemSystem s(p, st);
+  s.set_gravity(Vector3d::Zero());
+  const std::vector<Vector3d> x = Cluster(n, 7, 1.02 * p.diameter);
+  Vector3d c = Vector3d::Zero();
+  for (const Vector3d& xi : x) c += xi / n;
+  for (const Vector3d& xi : x) s.AddParticle(xi, -0.3 * (xi - c) / std::max((xi - c).norm(), 1e-9));
+  s.Finalize(1.5e-5);
+  return s;
+}
+
+TEST(Dem, ForcesAreEqualAndOppositeSoMomentumIsKept) {
+  DemSystem s = Implosion(500, 1);
+  const Vector3d p0 = s.Momentum();
+  for (int i = 0; i < 1500; ++i) s.Step();
+  EXPECT_GT(s.contacts(), 500);  // a packed, cohesive, plastic clump
+  const double scale = s.mass() * 0.3 * s.size();
+  EXPECT_LT((s.Momentum() - p0).norm(), 1e-12 * scale);
+}
+
+TEST(Dem, OneAndTwoThreadsGiveIdenticalStates) {
+  DemSystem a = Implosion(3000, 1), b = Implosion(3000, 2);
+  for (int i = 0; i < 1500; ++i) {
+    a.Step();
+    b.Step();
+  }
+  ASSERT_GT(a.contacts(), 3000);
+  ASSERT_GT(a.neighbour_builds(), 1);  // the history survived rebuilds on both
+  for (int i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a.positions()[i], b.positions()[i]) << "particle " << i;
+    ASSERT_EQ(a.velocities()[i], b.velocities()[i]) << "particle " << i;
+    ASSERT_EQ(a.plastic_deformation()[i], b.plastic_deformation()[i]) << "particle " << i;
+  }
+}
+
+TEST(Dem, StepAboveTheCriticalOneIsRefused) {
+  DemSystem s(Nominal(), DemSettings());
+  s.AddParticle(Vector3d::Zero());
+  const double crit = s.CriticalTimeStep().dt_crit;
+  // independent bound: 12 contacts of k_n on one particle, 2/omega, less for damping
+  const SoilParams p = Nominal();
+  EXPECT_LT(crit, 2.0 / std::sqrt(12.0 * p.NormalStiffness() / p.Mass()));
+  EXPECT_GT(crit, 1.5e-5);  // the paper's step is stable for these particles
+  try {
+    s.Finalize(1.2 * crit);
+    FAIL() << "a step above the critical one was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("critical step"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Dem, NanIsCaughtNamingStepParticleAndQuantity) {
+  DemSystem s = Implosion(100, 1);
+  s.Step();
+  s.mutable_velocity(5).x() = std::nan("");
+  try {
+    s.Step();
+    FAIL() << "a NaN velocity went through";
+  } catch (const SimulationError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("DEM step 2"), std::string::npos) << m;
+    EXPECT_NE(m.find("particle 5"), std::string::npos) << m;
+    EXPECT_NE(m.find("non-finite"), std::string::npos) << m;
+  }
+}
+
+TEST(Dem, ExcessiveOverlapStopsTheRun) {
+  DemSystem s(Nominal(), DemSettings());
+  s.set_gravity(Vector3d::Zero());
+  s.AddParticle(Vector3d::Zero());
+  s.AddParticle(Vector3d(0.75 * 0.03, 0, 0));  // 25 % of the diameter: beyond the 10 % limit
+  s.Finalize(1e-5);
+  try {
+    s.Step();
+    FAIL() << "a 25 % overlap went through";
+  } catch (const SimulationError& e) {
+    EXPECT_NE(std::string(e.what()).find("overlaps a neighbour by 0.24"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace dem_mobility
