@@ -152,5 +152,94 @@ TEST(Dem, ExcessiveOverlapStopsTheRun) {
   }
 }
 
+DemWall Quad(const std::string& name, const Vector3d& o, const Vector3d& e1, const Vector3d& e2) {
+  DemWall w;
+  w.name = name;
+  w.mesh.vertices = {o, o + e1, o + e1 + e2, o + e2};
+  w.mesh.faces = {{0, 1, 2}, {0, 2, 3}};
+  return w;
+}
+
+// one particle dropped onto a single triangle above its face, an edge and a vertex: it comes to
+// rest with the wall carrying exactly its weight (plasticity off: a particle this lightly loaded
+// keeps re-expanding at V_relax under eq. 16, see PouredBedSettles)
+TEST(Dem, ParticleRestsOnATriangleFaceEdgeAndVertex) {
+  SoilParams p = Nominal();
+  p.plasticity = false;
+  const double r = 0.5 * p.diameter;
+  const Vector3d spots[] = {{0.2, 0.2, 0}, {0.5, 0.0, 0}, {0.0, 0.0, 0}};
+  for (const Vector3d& at : spots) {
+    DemSystem s(p, DemSettings());
+    DemWall tri;
+    tri.name = "triangle";
+    tri.mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    tri.mesh.faces = {{0, 1, 2}};
+    s.AddWall(tri);
+    s.AddParticle(at + Vector3d(0, 0, r + 0.002));
+    s.Finalize(1.5e-5);
+    for (int i = 0; i < 40000; ++i) s.Step();  // 0.6 s
+    const double weight = p.Mass() * 9.81;
+    EXPECT_NEAR(s.wall(0).force.z(), -weight, 1e-6 * weight) << at.transpose();
+    EXPECT_NEAR(s.wall(0).force.head<2>().norm(), 0.0, 1e-9 * weight) << at.transpose();
+    EXPECT_LT(s.velocities()[0].norm(), 1e-6) << at.transpose();
+    EXPECT_NEAR(s.positions()[0].x(), at.x(), 1e-9);
+    // resting depth: repulsion starts at d0, carries the weight with k_n, plus the plastic flattening
+    const double d = p.adhesion_depth * p.diameter + weight / p.NormalStiffness() + s.plastic_deformation()[0];
+    EXPECT_NEAR(s.positions()[0].z(), r - d, 1e-9) << at.transpose();
+  }
+}
+
+// a few hundred particles poured into a box come to rest: slow, barely overlapping, the walls
+// carrying the whole weight. With plasticity, the particles whose largest compression is below
+// their adhesion relax (eq. 16) and so re-expand at up to V_relax: those near the surface never
+// quite stop, so the bound is V_relax there and far tighter without plasticity.
+DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* carried_fraction) {
+  SoilParams p = Nominal();
+  p.plasticity = plasticity;
+  const double D = p.diameter, L = 10 * 1.05 * D;
+  DemSettings st;
+  st.threads = 2;
+  DemSystem s(p, st);
+  s.AddWall(Quad("floor", {0, 0, 0}, {L, 0, 0}, {0, L, 0}));
+  s.AddWall(Quad("x0", {0, 0, 0}, {0, 0, L}, {0, L, 0}));
+  s.AddWall(Quad("x1", {L, 0, 0}, {0, L, 0}, {0, 0, L}));
+  s.AddWall(Quad("y0", {0, 0, 0}, {L, 0, 0}, {0, 0, L}));
+  s.AddWall(Quad("y1", {0, L, 0}, {0, 0, L}, {L, 0, 0}));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.02 * D, 0.02 * D);
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 10; ++j)
+      for (int i = 0; i < 10; ++i)
+        s.AddParticle(Vector3d((i + 0.5) * 1.05 * D + u(rng), (j + 0.5) * 1.05 * D + u(rng), (k + 0.6) * 1.1 * D));
+  s.Finalize(1.5e-5);
+  // 0.45 s; the wall load averaged over the last 0.06 s
+  Vector3d carried = Vector3d::Zero();
+  for (int i = 0; i < 30000; ++i) {
+    s.Step();
+    if (i >= 26000)
+      for (int w = 0; w < s.num_walls(); ++w) carried += s.wall(w).force / 4000.0;
+  }
+  *vmax = 0.0;
+  for (const Vector3d& v : s.velocities()) *vmax = std::max(*vmax, v.norm());
+  *overlap = 0.0;
+  for (int i = 0; i < s.size(); ++i)
+    for (int j = i + 1; j < s.size(); ++j)
+      *overlap = std::max(*overlap, (D - (s.positions()[i] - s.positions()[j]).norm()) / D);
+  *carried_fraction = -carried.z() / (s.size() * p.Mass() * 9.81);
+  return s;
+}
+
+TEST(Dem, PouredBedSettles) {
+  double vmax, overlap, carried;
+  PourIntoABox(false, &vmax, &overlap, &carried);
+  EXPECT_LT(vmax, 1e-3);
+  EXPECT_LT(overlap, 0.02);
+  EXPECT_NEAR(carried, 1.0, 0.01);
+  PourIntoABox(true, &vmax, &overlap, &carried);
+  EXPECT_LT(vmax, Nominal().relax_speed);
+  EXPECT_LT(overlap, 0.02);
+  EXPECT_NEAR(carried, 1.0, 0.01);
+}
+
 }  // namespace
 }  // namespace dem_mobility

@@ -2,6 +2,8 @@
 
 #include <omp.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 
@@ -11,6 +13,29 @@
 namespace dem_mobility {
 
 using Eigen::Vector3d;
+
+namespace {
+// closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5)
+Vector3d ClosestPointOnTriangle(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
+  const Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  const Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + (d1 / (d1 - d3)) * ab;
+  const Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+}  // namespace
 
 DemSystem::DemSystem(const SoilParams& soil, const DemSettings& settings) : soil_(soil), settings_(settings) {
   DM_THROW_UNLESS(settings.skin > 0.0 && settings.skin <= 1.0, "DEM skin ", settings.skin,
@@ -34,6 +59,37 @@ int DemSystem::AddParticle(const Vector3d& x, const Vector3d& v) {
   overlap_.push_back(0.0);
   rebuild_ = true;
   return static_cast<int>(x_.size()) - 1;
+}
+
+int DemSystem::AddWall(DemWall wall) {
+  DM_THROW_UNLESS(!finalized_, "wall '", wall.name, "': walls are added before Finalize()");
+  DM_THROW_UNLESS(!wall.mesh.faces.empty(), "wall '", wall.name, "' has no triangles");
+  DM_THROW_UNLESS(wall.friction >= 0.0 && wall.adhesion_factor >= 0.0, "wall '", wall.name,
+                  "': friction and adhesion_factor must be >= 0");
+  SoilParams wp = soil_;
+  wp.friction = wall.friction;
+  wall_soil_.push_back(wp);
+  walls_.push_back(std::move(wall));
+  rebuild_ = true;
+  return static_cast<int>(walls_.size()) - 1;
+}
+
+void DemSystem::UpdateWallVertices() {
+  wall_vertices_.resize(walls_.size());
+  for (size_t w = 0; w < walls_.size(); ++w) {
+    const DemWall& wl = walls_[w];
+    wall_vertices_[w].resize(wl.mesh.vertices.size());
+    for (size_t k = 0; k < wl.mesh.vertices.size(); ++k)
+      wall_vertices_[w][k] = wl.position + wl.rotation * wl.mesh.vertices[k];
+  }
+}
+
+double DemSystem::MaxWallDisplacement() const {
+  double m2 = 0.0;
+  for (size_t w = 0; w < wall_vertices_.size() && w < wall_built_vertices_.size(); ++w)
+    for (size_t k = 0; k < wall_vertices_[w].size(); ++k)
+      m2 = std::max(m2, (wall_vertices_[w][k] - wall_built_vertices_[w][k]).squaredNorm());
+  return std::sqrt(m2);
 }
 
 DemStepLimit DemSystem::CriticalTimeStep() const {
@@ -146,6 +202,37 @@ void DemSystem::BuildNeighbours() {
   nbr_.swap(nbr);
   hist_.swap(hist);
   touching_.swap(touching);
+
+  // walls: each particle's candidate triangles, those whose box (grown by the cutoff) holds it
+  const int W = num_walls();
+  UpdateWallVertices();
+  wall_tris_.clear();
+  wall_built_vertices_ = wall_vertices_;
+  for (int w = 0; w < W; ++w)
+    for (int f = 0; f < static_cast<int>(walls_[w].mesh.faces.size()); ++f) wall_tris_.push_back({w, f});
+  std::vector<std::vector<int>> cand(n);
+  if (!wall_tris_.empty()) {
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+    for (int i = 0; i < n; ++i)
+      for (int t = 0; t < static_cast<int>(wall_tris_.size()); ++t) {
+        const WallTri& tr = wall_tris_[t];
+        const auto& face = walls_[tr.wall].mesh.faces[tr.face];
+        const std::vector<Vector3d>& wv = wall_vertices_[tr.wall];
+        const Vector3d lo = wv[face[0]].cwiseMin(wv[face[1]]).cwiseMin(wv[face[2]]).array() - cutoff_;
+        const Vector3d hi = wv[face[0]].cwiseMax(wv[face[1]]).cwiseMax(wv[face[2]]).array() + cutoff_;
+        if ((x_[i].array() >= lo.array()).all() && (x_[i].array() <= hi.array()).all()) cand[i].push_back(t);
+      }
+  }
+  particle_tri_start_.assign(n + 1, 0);
+  for (int i = 0; i < n; ++i) particle_tri_start_[i + 1] = particle_tri_start_[i] + static_cast<int>(cand[i].size());
+  particle_tris_.resize(particle_tri_start_[n]);
+  for (int i = 0; i < n; ++i) std::copy(cand[i].begin(), cand[i].end(), particle_tris_.begin() + particle_tri_start_[i]);
+  if (static_cast<int>(wall_hist_.size()) != n * W) {
+    wall_hist_.resize(static_cast<size_t>(n) * W);
+    wall_touching_.resize(static_cast<size_t>(n) * W, 0);
+  }
+  wall_force_.assign(static_cast<size_t>(n) * W, Vector3d::Zero());
+  wall_moment_.assign(static_cast<size_t>(n) * W, Vector3d::Zero());
   rebuild_ = false;
   ++builds_;
 }
@@ -182,9 +269,74 @@ void DemSystem::ComputeForces() {
       max_rep = std::max(max_rep, fn.repulsion);
       touching_[k] = 1;
     }
+    // walls: per wall the deepest of the candidate triangles
+    const int W = static_cast<int>(walls_.size());
+    for (int w = 0; w < W; ++w) {
+      wall_force_[static_cast<size_t>(i) * W + w].setZero();
+      wall_moment_[static_cast<size_t>(i) * W + w].setZero();
+    }
+    for (int w = 0; w < W; ++w) {
+      const DemWall& wl = walls_[w];
+      double best = 0.0;
+      Vector3d q_best = Vector3d::Zero();
+      for (int k = particle_tri_start_[i]; k < particle_tri_start_[i + 1]; ++k) {
+        const WallTri& tr = wall_tris_[particle_tris_[k]];
+        if (tr.wall != w) continue;
+        // the triangle where the wall is now (it may have moved since the build)
+        const auto& face = wl.mesh.faces[tr.face];
+        const std::vector<Vector3d>& wv = wall_vertices_[w];
+        const Vector3d q = ClosestPointOnTriangle(x_[i], wv[face[0]], wv[face[1]], wv[face[2]]);
+        const double overlap = 0.5 * D - (x_[i] - q).norm();
+        if (overlap > best) {
+          best = overlap;
+          q_best = q;
+        }
+      }
+      const size_t hw = static_cast<size_t>(i) * W + w;
+      const double d = best - plastic_[i];
+      if (!(d > 0.0)) {
+        wall_hist_[hw] = TangentialHistory();
+        wall_touching_[hw] = 0;
+        continue;
+      }
+      max_overlap = std::max(max_overlap, best);
+      const Vector3d r = x_[i] - q_best;
+      const Vector3d nrm = r / r.norm();
+      const Vector3d vw = wl.velocity + wl.angular_velocity.cross(q_best - wl.position);
+      const Vector3d vr = v_[i] - vw;
+      const double vn = vr.dot(nrm);
+      const SoilParams& wp = wall_soil_[w];
+      const SoilNormalForce fn = ComputeSoilNormalForce(wp, d, -vn, wl.adhesion_factor * adhesion_max_[i]);
+      const Vector3d ft = ComputeSoilTangentialForce(wp, nrm, vr - vn * nrm, fn.repulsion, dt, &wall_hist_[hw]);
+      const Vector3d fc = fn.Total() * nrm + ft;
+      f += fc;
+      max_rep = std::max(max_rep, fn.repulsion);
+      wall_touching_[hw] = 1;
+      wall_force_[hw] = -fc;
+      wall_moment_[hw] = (q_best - wl.wrench_point).cross(-fc);
+    }
     f_[i] = f;
     max_repulsion_[i] = max_rep;
     overlap_[i] = max_overlap;
+  }
+  ComputeWallForces();
+}
+
+void DemSystem::ComputeWallForces() {
+  // summed in particle order, whatever the thread count
+  const int W = num_walls(), n = size();
+  for (int w = 0; w < W; ++w) {
+    DemWall& wl = walls_[w];
+    wl.force.setZero();
+    wl.moment.setZero();
+    wl.contacts = 0;
+    for (int i = 0; i < n; ++i) {
+      const size_t hw = static_cast<size_t>(i) * W + w;
+      if (!wall_touching_[hw]) continue;
+      wl.force += wall_force_[hw];
+      wl.moment += wall_moment_[hw];
+      ++wl.contacts;
+    }
   }
 }
 
@@ -203,7 +355,8 @@ void DemSystem::Step() {
   time_ += dt_;
   ++step_;
   CheckState();
-  if (rebuild_ || max_disp2 > half_skin * half_skin) BuildNeighbours();
+  UpdateWallVertices();  // the walls' poses were set for this step from outside
+  if (rebuild_ || max_disp2 > half_skin * half_skin || MaxWallDisplacement() > half_skin) BuildNeighbours();
   ComputeForces();
   CheckOverlaps();
 #pragma omp parallel for schedule(static) num_threads(settings_.threads)

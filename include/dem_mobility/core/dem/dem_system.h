@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "dem_mobility/core/dem/soil_law.h"
+#include "dem_mobility/core/multibody/trimesh.h"
 
 namespace dem_mobility {
 
@@ -32,6 +33,27 @@ struct DemStepLimit {
   std::string detail;
 };
 
+/// A rigid triangle mesh the particles touch: a container side, a lid, a cone, a wheel. Its pose
+/// and velocity are set from outside (static, prescribed motion, or driven by a multibody body);
+/// the solver returns the particles' total force on it and the moment about `wrench_point`.
+/// A particle touches a wall at one point (the deepest of its triangles), so a wall must be flat or
+/// convex; a container is several walls.
+struct DemWall {
+  std::string name;
+  TriMesh mesh;                                         ///< body coordinates
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();   ///< body origin, world
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();   ///< of the body origin, world
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< world
+  double friction = 0.5;          ///< particle-wall mu (0.5 to tire and cone, table 2)
+  double adhesion_factor = 0.0;   ///< wall adhesion as a fraction of the particle's maximum adhesion
+  Eigen::Vector3d wrench_point = Eigen::Vector3d::Zero();  ///< world point the moment is about
+  // results of the last force evaluation
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< on the wall, world
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();  ///< on the wall about wrench_point, world
+  int contacts = 0;
+};
+
 struct DemSettings {
   double skin = 0.1;            ///< Verlet skin as a fraction of the diameter
   int threads = 1;              ///< OpenMP threads
@@ -46,6 +68,12 @@ class DemSystem {
   /// Adds a particle (before or between steps); returns its index.
   int AddParticle(const Eigen::Vector3d& x, const Eigen::Vector3d& v = Eigen::Vector3d::Zero());
   void set_gravity(const Eigen::Vector3d& g) { gravity_ = g; }
+  /// Adds a wall (before Finalize); returns its index. A moving wall gets its pose and velocity
+  /// set through mutable_wall() before each Step (prescribed motion, or a multibody body's state).
+  int AddWall(DemWall wall);
+  DemWall& mutable_wall(int w) { return walls_[w]; }
+  const DemWall& wall(int w) const { return walls_[w]; }
+  int num_walls() const { return static_cast<int>(walls_.size()); }
 
   DemStepLimit CriticalTimeStep() const;
   /// Refuses (ConfigError naming the limit) a step above the critical one; computes the forces.
@@ -75,6 +103,9 @@ class DemSystem {
  private:
   void BuildNeighbours();
   void ComputeForces();
+  void ComputeWallForces();
+  void UpdateWallVertices();
+  double MaxWallDisplacement() const;
   void CheckState() const;
   void CheckOverlaps() const;
 
@@ -93,6 +124,19 @@ class DemSystem {
   std::vector<int> nbr_start_, nbr_;
   std::vector<TangentialHistory> hist_;
   std::vector<unsigned char> touching_;
+  // walls: world triangles at the last build, binned into the particle grid; per particle and
+  // wall one tangential history
+  std::vector<DemWall> walls_;
+  std::vector<TangentialHistory> wall_hist_;
+  std::vector<unsigned char> wall_touching_;
+  struct WallTri {
+    int wall, face;
+  };
+  std::vector<SoilParams> wall_soil_;                       ///< the law with each wall's friction
+  std::vector<std::vector<Eigen::Vector3d>> wall_vertices_, wall_built_vertices_;  ///< world
+  std::vector<WallTri> wall_tris_;
+  std::vector<int> particle_tri_start_, particle_tris_;  ///< CSR: candidate wall triangles per particle
+  std::vector<Eigen::Vector3d> wall_force_, wall_moment_;  ///< per particle and wall, summed per wall
 };
 
 }  // namespace dem_mobility

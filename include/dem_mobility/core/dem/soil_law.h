@@ -67,8 +67,9 @@ SoilNormalForce ComputeSoilNormalForce(const SoilParams& p, double d, double d_d
 double MaxAdhesionForce(const SoilParams& p, double delta_p);
 
 /// One step of a particle's plastic deformation: grows to fig. 8 at the stress of its largest
-/// repulsive force (never shrinks from loading), and relaxes by V_relax dt, floored at zero, while
-/// that force is below the particle's maximum adhesion (eq. 16). Unchanged when plasticity is off.
+/// repulsive force (never shrinks from loading), and relaxes by V_relax dt while that force is below
+/// the particle's maximum adhesion (eq. 16), floored at zero and at fig. 8's value for the present
+/// load (see soil_law.cpp). Unchanged when plasticity is off.
 double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double dt);
 
 /// Tangential (history) state of a contact: the elongation of the anchor spring.
