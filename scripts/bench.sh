@@ -4,14 +4,15 @@
 #   ./scripts/bench.sh vehicle_step     the 33-body vehicle's step on the road (core, no ROS)
 #   ./scripts/bench.sh cosim_exchange   round trip of the vehicle-terrain exchange between nodelets
 #   ./scripts/bench.sh road_scene       the 40 s road run end to end through ROS, with the bag
+#   ./scripts/bench.sh dem_step         the DEM solver on the LAMMPS reference bed, beside Debian's lammps
 source "$(dirname "$0")/lib.sh"
 want="${1:-all}"
-case "$want" in all|vehicle_step|cosim_exchange|road_scene) ;; *)
-  echo "unknown benchmark '$want' (have: vehicle_step cosim_exchange road_scene)" >&2; exit 2 ;;
+case "$want" in all|vehicle_step|cosim_exchange|road_scene|dem_step) ;; *)
+  echo "unknown benchmark '$want' (have: vehicle_step cosim_exchange road_scene dem_step)" >&2; exit 2 ;;
 esac
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}"
 build_core >/dev/null
-if [ "$want" != vehicle_step ]; then build_catkin >/dev/null; ros_env; fi
+if [ "$want" != vehicle_step ] && [ "$want" != dem_step ]; then build_catkin >/dev/null; ros_env; fi
 echo "# $(date -u +%Y-%m-%dT%H:%MZ) $(uname -m) $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
@@ -60,4 +61,22 @@ if [ "$want" = all ] || [ "$want" = road_scene ]; then
     echo "road_scene ${1}_us_per_step $(python3 -c "import yaml,sys; d=yaml.safe_load(open(sys.argv[1])); print(round(1e6*d['wall_time']/d['steps'],2))" "$r") us"
     echo "road_scene ${1}_bag_size $(du -m "$tmp/$1.bag" | cut -f1) MB"
   done
+fi
+
+if [ "$want" = all ] || [ "$want" = dem_step ]; then
+  "$DM_BUILD/core/bench/dem_step_bench" "$DM_ROOT/config/soils/nominal_clay.yaml" 1000 | tee "$tmp/dem.txt"
+  # the same bed in LAMMPS (Debian's package), 1 rank and 2 MPI ranks, timed 1000 steps
+  ensure_packages "${DM_BENCH_PACKAGES[@]}" >/dev/null
+  bed="$DM_ROOT/../shared/bench/lammps-bed.in"
+  if [ -f "$bed" ]; then
+    (cd "$tmp" && lmp -in "$bed" >lmp1.log 2>&1 && mpirun --allow-run-as-root --oversubscribe -np 2 lmp -in "$bed" >lmp2.log 2>&1)
+    rate() { awk '/Loop time of .* for 1000 steps/ {printf "%.3f", $(NF-1) * 1000 / $4 / 1e6}' "$1"; }
+    l1=$(rate "$tmp/lmp1.log"); l2=$(rate "$tmp/lmp2.log")
+    echo "dem_step lammps_rate_1rank $l1 Mparticle-steps/s"
+    echo "dem_step lammps_rate_2ranks $l2 Mparticle-steps/s"
+    ours=$(awk '/bed_rate_2threads/ {print $3}' "$tmp/dem.txt")
+    echo "dem_step lammps_ratio_2threads $(python3 -c "print(round($ours / $l2, 3))") ratio"
+  else
+    echo "dem_step: $bed not found; LAMMPS not run" >&2
+  fi
 fi

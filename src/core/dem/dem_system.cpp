@@ -37,7 +37,8 @@ Vector3d ClosestPointOnTriangle(const Vector3d& p, const Vector3d& a, const Vect
 }
 }  // namespace
 
-DemSystem::DemSystem(const SoilParams& soil, const DemSettings& settings) : soil_(soil), settings_(settings) {
+DemSystem::DemSystem(const SoilParams& soil, const DemSettings& settings)
+    : soil_(soil), settings_(settings), law_(soil) {
   DM_THROW_UNLESS(settings.skin > 0.0 && settings.skin <= 1.0, "DEM skin ", settings.skin,
                   " (fraction of the diameter) must lie in (0, 1]");
   DM_THROW_UNLESS(settings.threads >= 1, "DEM threads ", settings.threads, " must be >= 1");
@@ -68,7 +69,7 @@ int DemSystem::AddWall(DemWall wall) {
                   "': friction and adhesion_factor must be >= 0");
   SoilParams wp = soil_;
   wp.friction = wall.friction;
-  wall_soil_.push_back(wp);
+  wall_law_.emplace_back(wp);
   walls_.push_back(std::move(wall));
   rebuild_ = true;
   return static_cast<int>(walls_.size()) - 1;
@@ -239,7 +240,7 @@ void DemSystem::BuildNeighbours() {
 
 void DemSystem::ComputeForces() {
   const int n = size();
-  const double D = soil_.diameter, dt = dt_;
+  const double D = soil_.diameter, D2 = D * D, dt = dt_;
   const Vector3d weight = mass_ * gravity_;
 #pragma omp parallel for schedule(static) num_threads(settings_.threads)
   for (int i = 0; i < n; ++i) {
@@ -248,23 +249,32 @@ void DemSystem::ComputeForces() {
     for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
       const int j = nbr_[k];
       const Vector3d r = x_[i] - x_[j];
-      const double dist = r.norm();
-      // effective penetration: the overlap less both particles' plastic deformation (summed first,
-      // so that i and j compute it identically)
-      max_overlap = std::max(max_overlap, D - dist);
-      const double d = (D - dist) - (plastic_[i] + plastic_[j]);
-      if (!(d > 0.0) || dist <= 0.0) {
-        hist_[k] = TangentialHistory();
-        touching_[k] = 0;
+      const double r2 = r.squaredNorm();
+      if (r2 >= D2) {  // in the skin, not touching
+        if (touching_[k]) {
+          hist_[k] = TangentialHistory();
+          touching_[k] = 0;
+        }
         continue;
       }
-      const Vector3d nrm = r / dist;  // from j toward i
+      const double dist = std::sqrt(r2);
+      max_overlap = std::max(max_overlap, D - dist);
+      // effective penetration: the overlap less both particles' plastic deformation (summed first,
+      // so that i and j compute it identically)
+      const double d = (D - dist) - (plastic_[i] + plastic_[j]);
+      if (!(d > 0.0) || dist <= 0.0) {
+        if (touching_[k]) {
+          hist_[k] = TangentialHistory();
+          touching_[k] = 0;
+        }
+        continue;
+      }
+      const Vector3d nrm = r * (1.0 / dist);  // from j toward i
       const Vector3d vr = v_[i] - v_[j];
       const double vn = vr.dot(nrm);
-      const SoilNormalForce fn =
-          ComputeSoilNormalForce(soil_, d, -vn, std::min(adhesion_max_[i], adhesion_max_[j]));
+      const SoilNormalForce fn = law_.Normal(d, -vn, std::min(adhesion_max_[i], adhesion_max_[j]));
       const Vector3d vt = vr - vn * nrm;
-      const Vector3d ft = ComputeSoilTangentialForce(soil_, nrm, vt, fn.repulsion, dt, &hist_[k]);
+      const Vector3d ft = law_.Tangential(nrm, vt, fn.repulsion, dt, &hist_[k]);
       f += fn.Total() * nrm + ft;
       max_rep = std::max(max_rep, fn.repulsion);
       touching_[k] = 1;
@@ -305,9 +315,9 @@ void DemSystem::ComputeForces() {
       const Vector3d vw = wl.velocity + wl.angular_velocity.cross(q_best - wl.position);
       const Vector3d vr = v_[i] - vw;
       const double vn = vr.dot(nrm);
-      const SoilParams& wp = wall_soil_[w];
-      const SoilNormalForce fn = ComputeSoilNormalForce(wp, d, -vn, wl.adhesion_factor * adhesion_max_[i]);
-      const Vector3d ft = ComputeSoilTangentialForce(wp, nrm, vr - vn * nrm, fn.repulsion, dt, &wall_hist_[hw]);
+      const SoilContactLaw& wlaw = wall_law_[w];
+      const SoilNormalForce fn = wlaw.Normal(d, -vn, wl.adhesion_factor * adhesion_max_[i]);
+      const Vector3d ft = wlaw.Tangential(nrm, vr - vn * nrm, fn.repulsion, dt, &wall_hist_[hw]);
       const Vector3d fc = fn.Total() * nrm + ft;
       f += fc;
       max_rep = std::max(max_rep, fn.repulsion);
@@ -424,6 +434,15 @@ DemEnergy DemSystem::Energy() const {
     }
   }
   return e;
+}
+
+size_t DemSystem::MemoryBytes() const {
+  auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  size_t b = bytes(x_) + bytes(v_) + bytes(f_) + bytes(x_built_) + bytes(plastic_) + bytes(adhesion_max_) +
+             bytes(max_repulsion_) + bytes(overlap_) + bytes(nbr_start_) + bytes(nbr_) + bytes(hist_) +
+             bytes(touching_) + bytes(wall_hist_) + bytes(wall_touching_) + bytes(particle_tri_start_) +
+             bytes(particle_tris_) + bytes(wall_force_) + bytes(wall_moment_);
+  return b;
 }
 
 Vector3d DemSystem::Momentum() const {

@@ -43,17 +43,7 @@ double SoilParams::Area() const { return 0.25 * M_PI * diameter * diameter; }
 double SoilParams::Mass() const { return density * M_PI * diameter * diameter * diameter / 6.0; }
 
 SoilNormalForce ComputeSoilNormalForce(const SoilParams& p, double d, double d_dot, double f_adh_max) {
-  SoilNormalForce f;
-  if (!(d > 0.0)) return f;
-  const double d0 = p.adhesion_depth * p.diameter;
-  if (p.cohesion && f_adh_max > 0.0 && d < d0) {
-    const double dp = p.adhesion_peak * p.diameter;
-    f.adhesion = d <= dp ? -f_adh_max * d / dp : -f_adh_max * (d0 - d) / (d0 - dp);
-  }
-  if (d > d0) f.repulsion = p.NormalStiffness() * (d - d0);
-  const double c = p.NormalDamping();
-  f.damping = d_dot >= 0.0 ? c * d_dot : p.separation_factor * c * d_dot;
-  return f;
+  return SoilContactLaw(p).Normal(d, d_dot, f_adh_max);
 }
 
 double MaxAdhesionForce(const SoilParams& p, double delta_p) {
@@ -76,27 +66,7 @@ double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_
 
 Eigen::Vector3d ComputeSoilTangentialForce(const SoilParams& p, const Eigen::Vector3d& n, const Eigen::Vector3d& vt,
                                            double f_rep, double dt, TangentialHistory* h) {
-  // keep the spring in the current tangent plane, with its length (the contact frame turns)
-  Eigen::Vector3d s = h->spring;
-  const double len = s.norm();
-  s -= s.dot(n) * n;
-  const double len_t = s.norm();
-  if (len_t > 0.0) s *= len / len_t;
-  s += vt * dt;
-  const double k_t = p.TangentialStiffness();
-  const double vt_norm = vt.norm();
-  Eigen::Vector3d f_c = Eigen::Vector3d::Zero();
-  if (vt_norm > 0.0) f_c = (-p.friction * f_rep * std::min(1.0, vt_norm / p.slip_velocity) / vt_norm) * vt;
-  Eigen::Vector3d f_t = -k_t * s + f_c;
-  const double limit = p.friction * std::max(0.0, f_rep);
-  const double ft_norm = f_t.norm();
-  if (ft_norm > limit) {
-    f_t = ft_norm > 0.0 ? Eigen::Vector3d(f_t * (limit / ft_norm)) : Eigen::Vector3d::Zero();
-    // slip: the anchor moves so that the spring carries what the Coulomb element does not
-    s = k_t > 0.0 ? Eigen::Vector3d(-(f_t - f_c) / k_t) : Eigen::Vector3d::Zero();
-  }
-  h->spring = s;
-  return f_t - p.viscosity * vt;
+  return SoilContactLaw(p).Tangential(n, vt, f_rep, dt, h);
 }
 
 }  // namespace dem_mobility

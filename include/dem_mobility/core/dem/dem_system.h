@@ -98,6 +98,8 @@ class DemSystem {
   long neighbour_builds() const { return builds_; }
   int contacts() const;  ///< pairs in contact at the last force evaluation
   DemEnergy Energy() const;
+  /// Bytes held for the particles, neighbour lists, contact histories and walls.
+  size_t MemoryBytes() const;
   Eigen::Vector3d Momentum() const;
 
  private:
@@ -111,6 +113,7 @@ class DemSystem {
 
   SoilParams soil_;
   DemSettings settings_;
+  SoilContactLaw law_;
   double mass_ = 0.0, cutoff_ = 0.0;
   Eigen::Vector3d gravity_{0, 0, -9.81};
   double dt_ = 0.0, time_ = 0.0;
@@ -132,7 +135,7 @@ class DemSystem {
   struct WallTri {
     int wall, face;
   };
-  std::vector<SoilParams> wall_soil_;                       ///< the law with each wall's friction
+  std::vector<SoilContactLaw> wall_law_;                    ///< the law with each wall's friction
   std::vector<std::vector<Eigen::Vector3d>> wall_vertices_, wall_built_vertices_;  ///< world
   std::vector<WallTri> wall_tris_;
   std::vector<int> particle_tri_start_, particle_tris_;  ///< CSR: candidate wall triangles per particle

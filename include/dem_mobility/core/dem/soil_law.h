@@ -9,6 +9,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "dem_mobility/core/common/table.h"
@@ -55,6 +57,63 @@ struct SoilNormalForce {
   double Total() const { return adhesion + repulsion + damping; }
 };
 
+/// Tangential (history) state of a contact: the elongation of the anchor spring.
+struct TangentialHistory {
+  Eigen::Vector3d spring = Eigen::Vector3d::Zero();
+};
+
+/// The contact law with its constants worked out once (the solver's inner loop); the free
+/// functions below are the same law for one-off use.
+struct SoilContactLaw {
+  double k_n, c_n, k_t, d0, dp, mu, s_n, v_slip, inv_v_slip, c_t;
+  bool cohesion;
+  explicit SoilContactLaw(const SoilParams& p)
+      : k_n(p.NormalStiffness()),
+        c_n(p.NormalDamping()),
+        k_t(p.TangentialStiffness()),
+        d0(p.adhesion_depth * p.diameter),
+        dp(p.adhesion_peak * p.diameter),
+        mu(p.friction),
+        s_n(p.separation_factor),
+        v_slip(p.slip_velocity),
+        inv_v_slip(1.0 / p.slip_velocity),
+        c_t(p.viscosity),
+        cohesion(p.cohesion) {}
+
+  SoilNormalForce Normal(double d, double d_dot, double f_adh_max) const {
+    SoilNormalForce f;
+    if (!(d > 0.0)) return f;
+    if (cohesion && f_adh_max > 0.0 && d < d0)
+      f.adhesion = d <= dp ? -f_adh_max * d / dp : -f_adh_max * (d0 - d) / (d0 - dp);
+    if (d > d0) f.repulsion = k_n * (d - d0);
+    f.damping = d_dot >= 0.0 ? c_n * d_dot : s_n * c_n * d_dot;
+    return f;
+  }
+
+  [[gnu::always_inline]] Eigen::Vector3d Tangential(const Eigen::Vector3d& n, const Eigen::Vector3d& vt, double f_rep,
+                                                    double dt, TangentialHistory* h) const {
+    // keep the spring in the current tangent plane (projected, as LAMMPS' history springs are;
+    // the length lost is second order in the turn per step)
+    Eigen::Vector3d s = h->spring;
+    s -= s.dot(n) * n;
+    s += vt * dt;
+    // Coulomb element: mu f_rep along -vt, linear below the slip velocity
+    const double vt2 = vt.squaredNorm();
+    const double c = vt2 < v_slip * v_slip ? -mu * f_rep * inv_v_slip : -mu * f_rep / std::sqrt(vt2);
+    const Eigen::Vector3d f_c = c * vt;
+    Eigen::Vector3d f_t = -k_t * s + f_c;
+    const double limit = mu * std::max(0.0, f_rep);
+    const double ft2 = f_t.squaredNorm();
+    if (ft2 > limit * limit) {
+      f_t = ft2 > 0.0 ? Eigen::Vector3d(f_t * (limit / std::sqrt(ft2))) : Eigen::Vector3d::Zero();
+      // slip: the anchor moves so that the spring carries what the Coulomb element does not
+      s = k_t > 0.0 ? Eigen::Vector3d(-(f_t - f_c) / k_t) : Eigen::Vector3d::Zero();
+    }
+    h->spring = s;
+    return f_t - c_t * vt;
+  }
+};
+
 /// Normal force of a contact with effective penetration `d` (the geometric overlap less the plastic
 /// deformations of the two particles), penetration rate `d_dot` (> 0 approaching) and maximum
 /// adhesion `f_adh_max` [N] (fig. 7): for 0 < d < d0 attractive, rising to -f_adh_max at the peak
@@ -72,10 +131,6 @@ double MaxAdhesionForce(const SoilParams& p, double delta_p);
 /// load (see soil_law.cpp). Unchanged when plasticity is off.
 double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double dt);
 
-/// Tangential (history) state of a contact: the elongation of the anchor spring.
-struct TangentialHistory {
-  Eigen::Vector3d spring = Eigen::Vector3d::Zero();
-};
 
 /// Tangential force (eq. 13-14) of a contact with unit normal `n` (from the other body toward
 /// this one), relative tangential velocity `vt` (this body's contact point relative to the other's,
