@@ -172,7 +172,7 @@ void DemSystem::BuildNeighbours() {
           const long cell = (static_cast<long>(cz) * dims.y() + cy) * dims.x() + cx;
           for (int k = cell_start[cell]; k < cell_start[cell + 1]; ++k) {
             const int j = cell_particles[k];
-            if (j != i && (x_[i] - x_[j]).squaredNorm() < cut2) out.push_back(j);
+            if (j > i && (x_[i] - x_[j]).squaredNorm() < cut2) out.push_back(j);  // half list
           }
         }
     std::sort(out.begin(), out.end());
@@ -203,6 +203,18 @@ void DemSystem::BuildNeighbours() {
   nbr_.swap(nbr);
   hist_.swap(hist);
   touching_.swap(touching);
+  pair_force_.assign(nbr_.size(), Vector3d::Zero());
+  pair_rep_.assign(nbr_.size(), 0.0);
+  pair_overlap_.assign(nbr_.size(), 0.0);
+  // the reverse list: for each particle the pairs in which it is the second, ascending
+  rev_start_.assign(n + 1, 0);
+  for (int j : nbr_) ++rev_start_[j + 1];
+  for (int i = 0; i < n; ++i) rev_start_[i + 1] += rev_start_[i];
+  rev_.resize(nbr_.size());
+  {
+    std::vector<int> fill(rev_start_.begin(), rev_start_.end() - 1);
+    for (int k = 0; k < static_cast<int>(nbr_.size()); ++k) rev_[fill[nbr_[k]]++] = k;
+  }
 
   // walls: each particle's candidate triangles, those whose box (grown by the cutoff) holds it
   const int W = num_walls();
@@ -242,10 +254,9 @@ void DemSystem::ComputeForces() {
   const int n = size();
   const double D = soil_.diameter, D2 = D * D, dt = dt_;
   const Vector3d weight = mass_ * gravity_;
+  // each pair once (half list): its force on the first particle, its repulsion and overlap
 #pragma omp parallel for schedule(static) num_threads(settings_.threads)
   for (int i = 0; i < n; ++i) {
-    Vector3d f = weight;
-    double max_rep = 0.0, max_overlap = 0.0;
     for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
       const int j = nbr_[k];
       const Vector3d r = x_[i] - x_[j];
@@ -254,19 +265,23 @@ void DemSystem::ComputeForces() {
         if (touching_[k]) {
           hist_[k] = TangentialHistory();
           touching_[k] = 0;
+          pair_force_[k].setZero();
+          pair_rep_[k] = 0.0;
         }
+        if (pair_overlap_[k] != 0.0) pair_overlap_[k] = 0.0;
         continue;
       }
       const double dist = std::sqrt(r2);
-      max_overlap = std::max(max_overlap, D - dist);
-      // effective penetration: the overlap less both particles' plastic deformation (summed first,
-      // so that i and j compute it identically)
+      pair_overlap_[k] = D - dist;
+      // effective penetration: the overlap less both particles' plastic deformation
       const double d = (D - dist) - (plastic_[i] + plastic_[j]);
       if (!(d > 0.0) || dist <= 0.0) {
         if (touching_[k]) {
           hist_[k] = TangentialHistory();
           touching_[k] = 0;
         }
+        pair_force_[k].setZero();
+        pair_rep_[k] = 0.0;
         continue;
       }
       const Vector3d nrm = r * (1.0 / dist);  // from j toward i
@@ -275,9 +290,27 @@ void DemSystem::ComputeForces() {
       const SoilNormalForce fn = law_.Normal(d, -vn, std::min(adhesion_max_[i], adhesion_max_[j]));
       const Vector3d vt = vr - vn * nrm;
       const Vector3d ft = law_.Tangential(nrm, vt, fn.repulsion, dt, &hist_[k]);
-      f += fn.Total() * nrm + ft;
-      max_rep = std::max(max_rep, fn.repulsion);
+      pair_force_[k] = fn.Total() * nrm + ft;
+      pair_rep_[k] = fn.repulsion;
       touching_[k] = 1;
+    }
+  }
+  // every particle gathers its pairs in a fixed order (its own, then those it is second in):
+  // equal and opposite, and the same sums for any thread count
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+  for (int i = 0; i < n; ++i) {
+    Vector3d f = weight;
+    double max_rep = 0.0, max_overlap = 0.0;
+    for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
+      f += pair_force_[k];
+      max_rep = std::max(max_rep, pair_rep_[k]);
+      max_overlap = std::max(max_overlap, pair_overlap_[k]);
+    }
+    for (int m = rev_start_[i]; m < rev_start_[i + 1]; ++m) {
+      const int k = rev_[m];
+      f -= pair_force_[k];
+      max_rep = std::max(max_rep, pair_rep_[k]);
+      max_overlap = std::max(max_overlap, pair_overlap_[k]);
     }
     // walls: per wall the deepest of the candidate triangles
     const int W = static_cast<int>(walls_.size());
@@ -405,7 +438,7 @@ void DemSystem::CheckOverlaps() const {
 int DemSystem::contacts() const {
   int c = 0;
   for (unsigned char t : touching_) c += t;
-  return c / 2;
+  return c;
 }
 
 DemEnergy DemSystem::Energy() const {
@@ -418,7 +451,6 @@ DemEnergy DemSystem::Energy() const {
     for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
       const int j = nbr_[k];
       if (!touching_[k]) continue;
-      // each contact is listed twice: half of its energy from each side
       const double d = (D - (x_[i] - x_[j]).norm()) - (plastic_[i] + plastic_[j]);
       double u = 0.5 * kt * hist_[k].spring.squaredNorm();
       if (d > d0) u += 0.5 * kn * (d - d0) * (d - d0);
@@ -430,7 +462,7 @@ DemEnergy DemSystem::Energy() const {
                                  : 0.5 * fmax * dp + fmax * (a - dp) - 0.5 * fmax * (a - dp) * (a - dp) / (d0 - dp);
         u -= w;
       }
-      e.elastic += 0.5 * u;
+      e.elastic += u;
     }
   }
   return e;
@@ -440,6 +472,7 @@ size_t DemSystem::MemoryBytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   size_t b = bytes(x_) + bytes(v_) + bytes(f_) + bytes(x_built_) + bytes(plastic_) + bytes(adhesion_max_) +
              bytes(max_repulsion_) + bytes(overlap_) + bytes(nbr_start_) + bytes(nbr_) + bytes(hist_) +
+             bytes(pair_force_) + bytes(pair_rep_) + bytes(pair_overlap_) + bytes(rev_start_) + bytes(rev_) +
              bytes(touching_) + bytes(wall_hist_) + bytes(wall_touching_) + bytes(particle_tri_start_) +
              bytes(particle_tris_) + bytes(wall_force_) + bytes(wall_moment_);
   return b;

@@ -3,10 +3,10 @@
 // velocity Verlet (the explicit member of the multibody core's trapezoidal family), a Cartesian
 // cell grid with a Verlet skin, and OpenMP.
 //
-// Determinism: every particle sums the forces of its own contacts from a full neighbour list in
-// ascending neighbour order, and each contact's history is kept by both particles as exact
-// negatives of each other; so the forces are exactly equal and opposite, no thread ever writes
-// another particle's data, and the result is bit-for-bit the same for any number of threads.
+// Determinism: each pair's force is computed once (half neighbour list) and stored; then every
+// particle gathers its pairs' forces in a fixed order (the pairs it is first in, then those it is
+// second in, ascending). So the forces are exactly equal and opposite, no thread writes data
+// another thread writes, and the result is bit-for-bit the same for any number of threads.
 #pragma once
 
 #include <Eigen/Core>
@@ -123,10 +123,13 @@ class DemSystem {
   // particles
   std::vector<Eigen::Vector3d> x_, v_, f_, x_built_;
   std::vector<double> plastic_, adhesion_max_, max_repulsion_, overlap_;
-  // full neighbour list (CSR, ascending neighbour index) with each entry's contact history
-  std::vector<int> nbr_start_, nbr_;
+  // half neighbour list (CSR over the first particle, second ascending) with each pair's contact
+  // history and last force; the reverse list gives each particle the pairs it is second in
+  std::vector<int> nbr_start_, nbr_, rev_start_, rev_;
   std::vector<TangentialHistory> hist_;
   std::vector<unsigned char> touching_;
+  std::vector<Eigen::Vector3d> pair_force_;  ///< on the first particle of the pair
+  std::vector<double> pair_rep_, pair_overlap_;
   // walls: world triangles at the last build, binned into the particle grid; per particle and
   // wall one tangential history
   std::vector<DemWall> walls_;
