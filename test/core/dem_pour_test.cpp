@@ -1,0 +1,33 @@
+// The soil preparation scene: a poured bed settles, the lid consolidates it at its pressure, and
+// the released bed is denser than the poured one (the plastic deformation stays).
+#include <gtest/gtest.h>
+
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/scenes/dem_pour.h"
+
+namespace dem_mobility {
+namespace {
+
+TEST(DemPour, LidConsolidatesThePouredBed) {
+  DemPourParams p = DemPourParams::Read(YamlReader::LoadWithOverrides(
+      DM_CONFIG_DIR "/scenes/dem_pour.yaml",
+      {"particles=400", "box.length=0.3", "box.width=0.3", "settle_time=0.4", "lid.speed=0.2", "lid.hold_time=0.05",
+       "lid.release_time=0.05"}));
+  const DemPourResult r = RunDemPour(p);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_EQ(r.particles, 400);
+  // mass over volume, with the height the test recomputes from the result's own definition
+  EXPECT_NEAR(r.density_poured, 400 * p.soil.Mass() / (0.09 * r.height_poured), 1e-9);
+  // a random loose packing of spheres in a small walled box: solid fraction between 0.35 and 0.64
+  EXPECT_GT(r.density_poured, 0.35 * p.soil.density);
+  EXPECT_LT(r.density_poured, 0.64 * p.soil.density);
+  // the lid held its pressure (the mean over the hold, within the 5 % the controller allows)
+  EXPECT_NEAR(r.lid_pressure_reached, 33.3e3, 0.06 * 33.3e3);
+  // consolidation: denser and lower after the lid is gone, with plastic strain left
+  EXPECT_GT(r.density_consolidated, 1.03 * r.density_poured);
+  EXPECT_LT(r.height_consolidated, r.height_poured);
+  EXPECT_GT(r.mean_plastic_strain, 0.0);
+}
+
+}  // namespace
+}  // namespace dem_mobility
