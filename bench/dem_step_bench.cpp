@@ -15,14 +15,6 @@ using namespace dem_mobility;
 using Eigen::Vector3d;
 
 namespace {
-DemWall Quad(const std::string& name, const Vector3d& o, const Vector3d& e1, const Vector3d& e2) {
-  DemWall w;
-  w.name = name;
-  w.mesh.vertices = {o, o + e1, o + e1 + e2, o + e2};
-  w.mesh.faces = {{0, 1, 2}, {0, 2, 3}};
-  return w;
-}
-
 struct Figures {
   double rate, bytes_per_particle;
   int particles, contacts;
@@ -35,11 +27,11 @@ Figures Run(const SoilParams& soil, int threads, int steps) {
   const double a = 0.042;  // fcc lattice constant: nearest neighbours at a / sqrt(2) = 0.0297 m
   const int nx = 60, ny = 40;
   const double lx = nx * a, ly = ny * a, lz = 14 * a;
-  s.AddWall(Quad("floor", {0, 0, 0}, {lx, 0, 0}, {0, ly, 0}));
-  s.AddWall(Quad("x0", {0, 0, 0}, {0, 0, lz}, {0, ly, 0}));
-  s.AddWall(Quad("x1", {lx, 0, 0}, {0, ly, 0}, {0, 0, lz}));
-  s.AddWall(Quad("y0", {0, 0, 0}, {lx, 0, 0}, {0, 0, lz}));
-  s.AddWall(Quad("y1", {0, ly, 0}, {0, 0, lz}, {lx, 0, 0}));
+  s.AddWall(MakeQuadWall("floor", {0, 0, 0}, {lx, 0, 0}, {0, ly, 0}));
+  s.AddWall(MakeQuadWall("x0", {0, 0, 0}, {0, 0, lz}, {0, ly, 0}));
+  s.AddWall(MakeQuadWall("x1", {lx, 0, 0}, {0, ly, 0}, {0, 0, lz}));
+  s.AddWall(MakeQuadWall("y0", {0, 0, 0}, {lx, 0, 0}, {0, 0, lz}));
+  s.AddWall(MakeQuadWall("y1", {0, ly, 0}, {0, 0, lz}, {lx, 0, 0}));
   const double basis[4][3] = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}};
   for (int k = 0; k < 14; ++k)
     for (int j = 0; j < ny; ++j)

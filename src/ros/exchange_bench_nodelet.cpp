@@ -42,10 +42,12 @@ class ExchangeBenchNodelet : public nodelet::Nodelet {
           "bench server", timing);
       thread_ = std::thread([this] { Client(); });
     } else if (role == "server") {
-      server_ = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
-          nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches", timing);
-      if (!server_->ServeInline([this](const WheelStates::ConstPtr& req) { return Answer(*req); }))
-        thread_ = std::thread([this] { Server(); });
+      server_ = std::make_unique<ExchangeResponder<WheelStates, WheelWrenches>>(
+          std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(nh, transport, nh.resolveName("exchange/terrain"),
+                                                                       "exchange/wheel_states",
+                                                                       "exchange/wheel_wrenches", timing),
+          "bench server", [this](const WheelStates& req) { return Answer(req); },
+          [this](const std::string& m) { NODELET_ERROR("%s", m.c_str()); }, [](const std::string&) {});
     } else {
       NODELET_FATAL("parameter %s must be client or server", pnh.resolveName("role").c_str());
       ros::requestShutdown();
@@ -94,13 +96,8 @@ class ExchangeBenchNodelet : public nodelet::Nodelet {
     return resp;
   }
 
-  void Server() {
-    std::string why;
-    while (auto req = server_->Wait(stop_, &why)) server_->Reply(Answer(*req));
-  }
-
   std::unique_ptr<ExchangeClient<WheelStates, WheelWrenches>> client_;
-  std::unique_ptr<ExchangeServer<WheelStates, WheelWrenches>> server_;
+  std::unique_ptr<ExchangeResponder<WheelStates, WheelWrenches>> server_;
   std::vector<WheelWrench> wrenches_ = std::vector<WheelWrench>(4);
   uint64_t served_ = 0;
   int round_trips_ = 0, warmup_ = 0;

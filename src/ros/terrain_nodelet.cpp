@@ -1,14 +1,10 @@
 // dem_mobility/TerrainNodelet: the terrain side of the lock-step exchange. Builds the scene's
 // terrain model (core), answers each WheelStates with the WheelWrenches of the same step, and
 // shows the surface in rviz. No physics here: the model computes, the nodelet converts.
-#include <atomic>
-#include <thread>
-
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "dem_mobility/core/common/error.h"
 #include "dem_mobility/ros/conversions.h"
 
 namespace dem_mobility {
@@ -16,10 +12,7 @@ namespace dem_mobility {
 class TerrainNodelet : public nodelet::Nodelet {
  public:
   ~TerrainNodelet() override {
-    stop_ = true;
-    // the vehicle learns at once that its terrain is gone (instead of after its timeout)
-    if (server_) server_->Leave("the terrain nodelet was unloaded");
-    if (thread_.joinable()) thread_.join();
+    responder_.reset();  // the vehicle learns at once that its terrain is gone
     if (served_ > 0) NODELET_INFO("terrain: %lu exchanges answered", static_cast<unsigned long>(served_));
   }
 
@@ -28,71 +21,41 @@ class TerrainNodelet : public nodelet::Nodelet {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     std::string transport;
+    std::unique_ptr<ExchangeServer<WheelStates, WheelWrenches>> server;
     try {
       const RoadSceneParams scene = LoadScene(nh);
       const ExchangeTiming timing = LoadExchangeTiming(pnh, &transport);
       pnh.param<std::string>("frame_id", frame_id_, "odom");
       model_ = LoadTerrainModel(scene.terrain_file, scene.vehicle_file);
-      server_ = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
+      server = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
           nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches", timing);
       NODELET_INFO("terrain '%s' from %s (%zu triangles), exchange over %s", model_->kind().c_str(),
                    scene.terrain_file.c_str(), model_->Surface().faces.size(), transport.c_str());
     } catch (const std::exception& e) {
       NODELET_FATAL("%s", e.what());
-      // in one manager, the vehicle finds the channel closed with the reason and ends the run
-      // (writing its result); a standalone terrain ends its process
-      if (pnh.param<std::string>("exchange_transport", "inline") != "topics") {
-        failed_ = ChannelRegistry::Get<WheelStates, WheelWrenches>(nh.resolveName("exchange/terrain"));
-        failed_->Close(std::string("the terrain could not start: ") + e.what());
-      } else {
-        ros::requestShutdown();
-      }
+      failed_ = RefuseExchange<WheelStates, WheelWrenches>(transport, nh.resolveName("exchange/terrain"),
+                                                          std::string("the terrain could not start: ") + e.what());
       return;
     }
     markers_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/markers", 1, true);
     PublishSurface();
-    // inline: the vehicle's thread runs Answer; otherwise this nodelet's own thread does
-    if (!server_->ServeInline([this](const WheelStates::ConstPtr& req) { return AnswerInline(req); }))
-      thread_ = std::thread([this] { Serve(); });
+    responder_ = std::make_unique<ExchangeResponder<WheelStates, WheelWrenches>>(
+        std::move(server), "terrain", [this](const WheelStates& req) { return Answer(req); },
+        [this](const std::string& m) { NODELET_ERROR("%s", m.c_str()); },
+        [this](const std::string& m) { NODELET_INFO("%s", m.c_str()); });
   }
 
   /// The wrenches of one exchange (the model's, converted).
   WheelWrenches::ConstPtr Answer(const WheelStates& req) {
-    const long step = static_cast<long>(req.step);
-    DM_THROW_UNLESS(step > last_step_, "wheel states of step ", step, " after step ", last_step_,
-                    ": the lock-step order is broken");
     FromMsg(req, &states_);
-    model_->Compute(step, req.header.stamp.toSec(), states_, &wrenches_);
+    model_->Compute(static_cast<long>(req.step), req.header.stamp.toSec(), states_, &wrenches_);
     auto resp = boost::make_shared<WheelWrenches>();
     resp->header.stamp = req.header.stamp;
     resp->header.frame_id = req.header.frame_id;
     resp->step = req.step;
     resp->served = ++served_;
     ToMsg(wrenches_, resp.get());
-    last_step_ = step;
     return resp;
-  }
-
-  WheelWrenches::ConstPtr AnswerInline(const WheelStates::ConstPtr& req) {
-    try {
-      return Answer(*req);
-    } catch (const std::exception& e) {
-      NODELET_ERROR("terrain: %s", e.what());
-      server_->LeaveFromHandler(std::string("the terrain failed: ") + e.what());
-      return nullptr;
-    }
-  }
-
-  void Serve() {
-    std::string why;
-    try {
-      while (auto req = server_->Wait(stop_, &why)) server_->Reply(Answer(*req));
-      NODELET_INFO("terrain: %lu exchanges answered; the exchange ended (%s)", static_cast<unsigned long>(served_),
-                   why.c_str());
-    } catch (const std::exception& e) {
-      NODELET_ERROR("terrain: %s", e.what());
-      server_->Leave(std::string("the terrain failed: ") + e.what());
-    }
   }
 
   void PublishSurface() {
@@ -144,16 +107,13 @@ class TerrainNodelet : public nodelet::Nodelet {
   }
 
   std::unique_ptr<TerrainModel> model_;
-  std::unique_ptr<ExchangeServer<WheelStates, WheelWrenches>> server_;
+  std::unique_ptr<ExchangeResponder<WheelStates, WheelWrenches>> responder_;
   std::shared_ptr<Channel<WheelStates, WheelWrenches>> failed_;  ///< held closed when the setup failed
   ros::Publisher markers_;
   std::string frame_id_;
   std::vector<WheelState> states_;
   std::vector<WheelWrench> wrenches_;
   uint64_t served_ = 0;
-  long last_step_ = -1;
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
 };
 
 }  // namespace dem_mobility

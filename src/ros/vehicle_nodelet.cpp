@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -125,6 +126,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       check(log_rate >= 0.0, "log_rate", "must be >= 0 Hz (0: every step)");
       check(clock_rate > 0.0, "clock_rate", "must be > 0 Hz");
       check(max_rtf_ >= 0.0, "max_real_time_factor", "must be >= 0 (0: as fast as possible)");
+      check(force_scale_ > 0.0 && std::isfinite(force_scale_), "force_scale", "must be a positive length per force [m/N]");
       log_rate_ = log_rate;
       clock_rate_ = clock_rate;
       if (!result_file_.empty()) {

@@ -152,14 +152,6 @@ TEST(Dem, ExcessiveOverlapStopsTheRun) {
   }
 }
 
-DemWall Quad(const std::string& name, const Vector3d& o, const Vector3d& e1, const Vector3d& e2) {
-  DemWall w;
-  w.name = name;
-  w.mesh.vertices = {o, o + e1, o + e1 + e2, o + e2};
-  w.mesh.faces = {{0, 1, 2}, {0, 2, 3}};
-  return w;
-}
-
 // one particle dropped onto a single triangle above its face, an edge and a vertex: it comes to
 // rest with the wall carrying exactly its weight (plasticity off: a particle this lightly loaded
 // keeps re-expanding at V_relax under eq. 16, see PouredBedSettles)
@@ -200,11 +192,11 @@ DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* c
   DemSettings st;
   st.threads = 2;
   DemSystem s(p, st);
-  s.AddWall(Quad("floor", {0, 0, 0}, {L, 0, 0}, {0, L, 0}));
-  s.AddWall(Quad("x0", {0, 0, 0}, {0, 0, L}, {0, L, 0}));
-  s.AddWall(Quad("x1", {L, 0, 0}, {0, L, 0}, {0, 0, L}));
-  s.AddWall(Quad("y0", {0, 0, 0}, {L, 0, 0}, {0, 0, L}));
-  s.AddWall(Quad("y1", {0, L, 0}, {0, 0, L}, {L, 0, 0}));
+  s.AddWall(MakeQuadWall("floor", {0, 0, 0}, {L, 0, 0}, {0, L, 0}));
+  s.AddWall(MakeQuadWall("x0", {0, 0, 0}, {0, 0, L}, {0, L, 0}));
+  s.AddWall(MakeQuadWall("x1", {L, 0, 0}, {0, L, 0}, {0, 0, L}));
+  s.AddWall(MakeQuadWall("y0", {0, 0, 0}, {L, 0, 0}, {0, 0, L}));
+  s.AddWall(MakeQuadWall("y1", {0, L, 0}, {0, 0, L}, {L, 0, 0}));
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-0.02 * D, 0.02 * D);
   for (int k = 0; k < 4; ++k)

@@ -123,12 +123,7 @@ struct Channel {
   std::mutex handler_mutex;
   Handler handler;
   void Close(const std::string& why) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (closed_by.empty()) closed_by = why;
-    }
-    requests.Close();
-    responses.Close();
+    CloseFromHandler(why);
     std::lock_guard<std::mutex> lock(handler_mutex);
     handler = nullptr;
   }
@@ -354,5 +349,88 @@ class ExchangeServer {
   ros::Publisher pub_;
   ros::Subscriber sub_;
 };
+
+/// The answering nodelet's side of an exchange, whatever the transport: `answer` turns a request
+/// into its response (and throws when it cannot). Inline, the client's thread runs it; otherwise a
+/// thread of its own waits for requests. Every request must be newer than the last (the lock-step
+/// order); a failing answer leaves the exchange with the reason, so the client stops at once.
+/// Destroying the responder (the nodelet unloaded) leaves the exchange too.
+template <class Req, class Resp>
+class ExchangeResponder {
+ public:
+  using RespPtr = boost::shared_ptr<const Resp>;
+  using Answer = std::function<RespPtr(const Req&)>;
+  using Report = std::function<void(const std::string&)>;
+
+  /// `who` names the side in messages ("terrain"); `error` and `info` report (the nodelet's log).
+  ExchangeResponder(std::unique_ptr<ExchangeServer<Req, Resp>> server, std::string who, Answer answer, Report error,
+                    Report info)
+      : server_(std::move(server)),
+        who_(std::move(who)),
+        answer_(std::move(answer)),
+        error_(std::move(error)),
+        info_(std::move(info)) {
+    if (!server_->ServeInline([this](const boost::shared_ptr<const Req>& req) { return AnswerInline(*req); }))
+      thread_ = std::thread([this] { Serve(); });
+  }
+  ~ExchangeResponder() {
+    stop_ = true;
+    server_->Leave("the " + who_ + " nodelet was unloaded");
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  RespPtr Checked(const Req& req) {
+    const long step = static_cast<long>(req.step);
+    if (step <= last_step_)
+      throw ExchangeError("request of step " + std::to_string(step) + " after step " + std::to_string(last_step_) +
+                          ": the lock-step order is broken");
+    RespPtr resp = answer_(req);
+    last_step_ = step;
+    return resp;
+  }
+  RespPtr AnswerInline(const Req& req) {
+    try {
+      return Checked(req);
+    } catch (const std::exception& e) {
+      error_(who_ + ": " + e.what());
+      server_->LeaveFromHandler("the " + who_ + " failed: " + e.what());
+      return nullptr;
+    }
+  }
+  void Serve() {
+    std::string why;
+    try {
+      while (auto req = server_->Wait(stop_, &why)) server_->Reply(Checked(*req));
+      info_(who_ + ": the exchange ended (" + why + ")");
+    } catch (const std::exception& e) {
+      error_(who_ + ": " + e.what());
+      server_->Leave("the " + who_ + " failed: " + e.what());
+    }
+  }
+
+  std::unique_ptr<ExchangeServer<Req, Resp>> server_;
+  std::string who_;
+  Answer answer_;
+  Report error_, info_;
+  long last_step_ = -1;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+/// A nodelet that answers an exchange but could not start: in one manager it leaves the channel
+/// closed with the reason (the client then stops the run and writes its result); a standalone one
+/// ends its process. Returns the channel to hold while the nodelet lives.
+template <class Req, class Resp>
+std::shared_ptr<Channel<Req, Resp>> RefuseExchange(const std::string& transport, const std::string& name,
+                                                   const std::string& why) {
+  if (transport == "topics") {
+    ros::requestShutdown();
+    return nullptr;
+  }
+  auto ch = ChannelRegistry::Get<Req, Resp>(name);
+  ch->Close(why);
+  return ch;
+}
 
 }  // namespace dem_mobility

@@ -1,7 +1,5 @@
 #include "dem_mobility/core/dem/dem_system.h"
 
-#include <omp.h>
-
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -60,6 +58,14 @@ int DemSystem::AddParticle(const Vector3d& x, const Vector3d& v) {
   overlap_.push_back(0.0);
   rebuild_ = true;
   return static_cast<int>(x_.size()) - 1;
+}
+
+DemWall MakeQuadWall(const std::string& name, const Vector3d& o, const Vector3d& e1, const Vector3d& e2) {
+  DemWall w;
+  w.name = name;
+  w.mesh.vertices = {o, o + e1, o + e1 + e2, o + e2};
+  w.mesh.faces = {{0, 1, 2}, {0, 2, 3}};
+  return w;
 }
 
 int DemSystem::AddWall(DemWall wall) {

@@ -169,7 +169,6 @@ void TireContact::Apply(Bodies& bodies, long step) {
   const TireGeometry& T = *tire;
   if (history.size() != T.mesh.vertices.size()) history.resize(T.mesh.vertices.size());
   last = ContactSummary();
-  applied_step = step;
   const Vector3d u = B.R.col(0), a = B.R.col(1), w = B.R.col(2);
   const double reach = T.radius + 0.5 * T.width;
   const double zmax = terrain->MaxHeight(B.x.head<2>().array() - reach, B.x.head<2>().array() + reach);
@@ -232,31 +231,11 @@ void TireContact::Apply(Bodies& bodies, long step) {
     last.torque += m * a;
   }
 }
-double TireContact::PotentialEnergy(const Bodies& bodies) const {
-  double e = 0.0;
-  const RigidBody& B = bodies[body];
-  for (size_t i = 0; i < history.size(); ++i)
-    if (history[i].last_step == applied_step)
-      e += ContactPointEnergy(params, *terrain, B.PointWorld(tire->mesh.vertices[i]), history[i], applied_step);
-  return e;
-}
 int TireContact::SimultaneousVertices() const {
   // vertices that can be in contact at once: the columns within the terrain's max_depth
   const double half = std::acos(std::max(-1.0, 1.0 - terrain->max_depth() / tire->radius));
   const int cols = 1 + 2 * static_cast<int>(std::ceil(half / (2.0 * M_PI / tire->n_circ)));
   return std::min(tire->n_circ, cols) * tire->n_lat;
-}
-StiffnessInfo TireContact::Stiffness(const Bodies& bodies) const {
-  const RigidBody& B = bodies[body];
-  const int n = SimultaneousVertices();
-  const double k = std::max(params.k_n, params.k_t);
-  const double w2 = n * k * InverseEffectiveMass(B, Vector3d(0, 0, tire->radius));
-  StiffnessInfo s;
-  s.omega = std::sqrt(w2);
-  const double m_eff = n * k / w2;
-  s.zeta = params.c_n * n / (2.0 * std::sqrt(n * k * m_eff));
-  s.detail = detail::Concat(n, " tire vertices of k = ", k, " N/m on '", B.name, "' ", B.mass, " kg");
-  return s;
 }
 
 }  // namespace dem_mobility

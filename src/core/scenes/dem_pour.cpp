@@ -56,17 +56,6 @@ double LayerHeight(const DemSystem& s) {
   return sum / top + 0.5 * s.soil().diameter;
 }
 
-namespace {
-DemWall Quad(const std::string& name, const Vector3d& o, const Vector3d& e1, const Vector3d& e2) {
-  DemWall w;
-  w.name = name;
-  w.mesh.vertices = {o, o + e1, o + e1 + e2, o + e2};
-  w.mesh.faces = {{0, 1, 2}, {0, 2, 3}};
-  w.friction = 0.5;
-  return w;
-}
-}  // namespace
-
 DemPourResult RunDemPour(const DemPourParams& p) {
   DemPourResult r;
   const auto wall0 = std::chrono::steady_clock::now();
@@ -80,12 +69,12 @@ DemPourResult RunDemPour(const DemPourParams& p) {
   const int nx = std::max(1, static_cast<int>((L - D) / a)), ny = std::max(1, static_cast<int>((W - D) / a));
   const int layers = (p.particles + nx * ny - 1) / (nx * ny);
   const double H = (layers + 2) * a;
-  s.AddWall(Quad("floor", {0, 0, 0}, {L, 0, 0}, {0, W, 0}));
-  s.AddWall(Quad("x0", {0, 0, 0}, {0, 0, H}, {0, W, 0}));
-  s.AddWall(Quad("x1", {L, 0, 0}, {0, W, 0}, {0, 0, H}));
-  s.AddWall(Quad("y0", {0, 0, 0}, {L, 0, 0}, {0, 0, H}));
-  s.AddWall(Quad("y1", {0, W, 0}, {0, 0, H}, {L, 0, 0}));
-  DemWall lid = Quad("lid", {0, 0, 0}, {0, W, 0}, {L, 0, 0});  // normal down
+  s.AddWall(MakeQuadWall("floor", {0, 0, 0}, {L, 0, 0}, {0, W, 0}));
+  s.AddWall(MakeQuadWall("x0", {0, 0, 0}, {0, 0, H}, {0, W, 0}));
+  s.AddWall(MakeQuadWall("x1", {L, 0, 0}, {0, W, 0}, {0, 0, H}));
+  s.AddWall(MakeQuadWall("y0", {0, 0, 0}, {L, 0, 0}, {0, 0, H}));
+  s.AddWall(MakeQuadWall("y1", {0, W, 0}, {0, 0, H}, {L, 0, 0}));
+  DemWall lid = MakeQuadWall("lid", {0, 0, 0}, {0, W, 0}, {L, 0, 0});  // normal down
   lid.position = Vector3d(0, 0, H + a);
   const int lid_index = s.AddWall(lid);
   std::mt19937 rng(p.seed);

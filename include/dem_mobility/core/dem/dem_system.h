@@ -54,6 +54,10 @@ struct DemWall {
   int contacts = 0;
 };
 
+/// A flat rectangular wall: corner `o`, edges `e1` and `e2` (two triangles).
+DemWall MakeQuadWall(const std::string& name, const Eigen::Vector3d& o, const Eigen::Vector3d& e1,
+                     const Eigen::Vector3d& e2);
+
 struct DemSettings {
   double skin = 0.1;            ///< Verlet skin as a fraction of the diameter
   int threads = 1;              ///< OpenMP threads

@@ -88,10 +88,7 @@ struct TireContact {
   const TerrainMesh* terrain = nullptr;
   std::vector<ContactHistory> history;  ///< one per tire vertex
   ContactSummary last;
-  long applied_step = -1;  ///< step of the last Apply
   void Apply(Bodies& bodies, long step);
-  double PotentialEnergy(const Bodies& bodies) const;
-  StiffnessInfo Stiffness(const Bodies& bodies) const;
   /// How many tire vertices can touch the terrain at once (the columns within its max_depth).
   int SimultaneousVertices() const;
 };
