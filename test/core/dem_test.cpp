@@ -37,8 +37,8 @@ double Collide(const SoilParams& p, double v0, double dt_fraction) {
   s.AddParticle(Vector3d(0.5 * D + 1e-4, 0, 0), Vector3d(-v0, 0, 0));
   const double m_eff = 0.5 * p.Mass(), k = p.NormalStiffness();
   s.Finalize(dt_fraction * 2.0 * std::sqrt(m_eff / k));
-  for (int i = 0; i < 200000 && !(s.positions()[1].x() - s.positions()[0].x() > D + 2e-4); ++i) s.Step();
-  return s.velocities()[1].x();
+  for (int i = 0; i < 200000 && !(s.position(1).x() - s.position(0).x() > D + 2e-4); ++i) s.Step();
+  return s.velocity(1).x();
 }
 
 TEST(Dem, UndampedHeadOnCollisionConservesEnergy) {
@@ -101,9 +101,9 @@ TEST(Dem, OneAndTwoThreadsGiveIdenticalStates) {
   ASSERT_GT(a.contacts(), 3000);
   ASSERT_GT(a.neighbour_builds(), 1);  // the history survived rebuilds on both
   for (int i = 0; i < a.size(); ++i) {
-    ASSERT_EQ(a.positions()[i], b.positions()[i]) << "particle " << i;
-    ASSERT_EQ(a.velocities()[i], b.velocities()[i]) << "particle " << i;
-    ASSERT_EQ(a.plastic_deformation()[i], b.plastic_deformation()[i]) << "particle " << i;
+    ASSERT_EQ(a.position(i), b.position(i)) << "particle " << i;
+    ASSERT_EQ(a.velocity(i), b.velocity(i)) << "particle " << i;
+    ASSERT_EQ(a.plastic_deformation(i), b.plastic_deformation(i)) << "particle " << i;
   }
 }
 
@@ -176,7 +176,7 @@ TEST(Dem, ParticleRestsOnATriangleFaceEdgeAndVertex) {
     EXPECT_LT(s.velocities()[0].norm(), 1e-6) << at.transpose();
     EXPECT_NEAR(s.positions()[0].x(), at.x(), 1e-9);
     // resting depth: repulsion starts at d0, carries the weight with k_n, plus the plastic flattening
-    const double d = p.adhesion_depth * p.diameter + weight / p.NormalStiffness() + s.plastic_deformation()[0];
+    const double d = p.adhesion_depth * p.diameter + weight / p.NormalStiffness() + s.plastic_deformation(0);
     EXPECT_NEAR(s.positions()[0].z(), r - d, 1e-9) << at.transpose();
   }
 }
@@ -214,9 +214,9 @@ DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* c
   *vmax = 0.0;
   for (const Vector3d& v : s.velocities()) *vmax = std::max(*vmax, v.norm());
   *overlap = 0.0;
+  const std::vector<Vector3d> x = s.positions();
   for (int i = 0; i < s.size(); ++i)
-    for (int j = i + 1; j < s.size(); ++j)
-      *overlap = std::max(*overlap, (D - (s.positions()[i] - s.positions()[j]).norm()) / D);
+    for (int j = i + 1; j < s.size(); ++j) *overlap = std::max(*overlap, (D - (x[i] - x[j]).norm()) / D);
   *carried_fraction = -carried.z() / (s.size() * p.Mass() * 9.81);
   return s;
 }

@@ -144,7 +144,7 @@ DemPourResult RunDemPour(const DemPourParams& p) {
     r.error = e.what();
   }
   double strain = 0.0;
-  for (double dp : s.plastic_deformation()) strain += dp / D;
+  for (double dp : s.plastic_deformations()) strain += dp / D;
   r.mean_plastic_strain = strain / std::max(1, s.size());
   r.steps = s.step_count();
   r.sim_time = s.time();

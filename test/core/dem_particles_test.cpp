@@ -1,0 +1,197 @@
+// The DEM solver's particle bookkeeping and energy ledger: particles added and removed between steps
+// without a full rebuild (against a system that rebuilt), stable IDs, determinism of an emit/remove
+// stream across thread counts, and the work of a moving wall and the dissipation of a damped
+// collision against their analytic values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/dem/dem_system.h"
+
+namespace dem_mobility {
+namespace {
+
+using Eigen::Vector3d;
+
+SoilParams Nominal() { return SoilParams::Read(YamlReader::Load(DM_CONFIG_DIR "/soils/nominal_clay.yaml")); }
+
+SoilParams Elastic(double damping_area) {
+  SoilParams p = Nominal();
+  p.cohesion = false;
+  p.plasticity = false;
+  p.adhesion_depth = p.adhesion_peak = 0.0;
+  p.friction = 0.0;
+  p.damping_area = damping_area;
+  p.separation_factor = 1.0;
+  return p;
+}
+
+// a 6 x 6 x 3 lattice of cohesive particles on a floor, touching (1 % overlap), settled a little
+DemSystem SmallBed(int slack, int threads) {
+  const SoilParams p = Nominal();
+  const double D = p.diameter, a = 0.99 * D;
+  DemSettings st;
+  st.list_slack = slack;
+  st.threads = threads;
+  DemSystem s(p, st);
+  s.AddWall(MakeQuadWall("floor", {-D, -D, 0}, {8 * D, 0, 0}, {0, 8 * D, 0}));
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 6; ++j)
+      for (int i = 0; i < 6; ++i) s.AddParticle(Vector3d(i * a, j * a, 0.495 * D + k * a));
+  s.Finalize(1.5e-5);
+  for (int i = 0; i < 2000; ++i) s.Step();
+  return s;
+}
+
+TEST(DemParticles, AddingAParticleExtendsTheListsWithoutARebuild) {
+  // A has room in its lists, B none: A takes the new particle in place, B rebuilds everything;
+  // both must then move the same (to round-off: the force sums may run in another order)
+  DemSystem a = SmallBed(4, 1), b = SmallBed(0, 1);
+  const double D = a.soil().diameter;
+  const Vector3d top = a.position(3 * 36 - 1) + Vector3d(0, 0, 0.99 * D);  // on the last particle
+  const long builds_a = a.neighbour_builds(), builds_b = b.neighbour_builds();
+  const int id_a = a.AddParticle(top, Vector3d(0, 0, -0.05));
+  const int id_b = b.AddParticle(top, Vector3d(0, 0, -0.05));
+  EXPECT_EQ(id_a, 108);
+  EXPECT_EQ(id_b, 108);
+  EXPECT_EQ(a.neighbour_builds(), builds_a) << "an added particle must not rebuild the lists";
+  ASSERT_EQ(b.neighbour_builds(), builds_b + 1) << "B was meant to overflow its lists";
+  EXPECT_EQ(b.overflow_builds(), 1);
+  for (int i = 0; i < 3000; ++i) {
+    a.Step();
+    b.Step();
+  }
+  EXPECT_GT(a.contacts(), 0);
+  EXPECT_EQ(a.contacts(), b.contacts());
+  double worst = 0.0;
+  for (int id = 0; id < a.size(); ++id) worst = std::max(worst, (a.position(id) - b.position(id)).norm());
+  EXPECT_LT(worst, 1e-9 * D);
+  // it landed on the bed and stayed there (adhesion holds it; it neither sank in nor bounced off)
+  EXPECT_NEAR(a.position(id_a).z(), top.z(), 0.02 * D);
+  EXPECT_LT(a.velocity(id_a).norm(), 0.05);
+}
+
+TEST(DemParticles, RemovingTheParticleBelowLetsTheOneAboveFall) {
+  SoilParams p = Elastic(2.1e4);
+  const double D = p.diameter;
+  DemSystem s(p, DemSettings());
+  s.AddWall(MakeQuadWall("floor", {-D, -D, 0}, {2 * D, 0, 0}, {0, 2 * D, 0}));
+  const int below = s.AddParticle(Vector3d(0, 0, 0.5 * D));
+  const int above = s.AddParticle(Vector3d(0, 0, 1.5 * D));
+  s.Finalize(1.5e-5);
+  for (int i = 0; i < 20000; ++i) s.Step();  // settled: the lower one carries the upper one
+  ASSERT_LT(s.velocity(above).norm(), 1e-6);
+  const Vector3d resting = s.position(below);
+  s.RemoveParticle(below);
+  EXPECT_FALSE(s.alive(below));
+  EXPECT_EQ(s.num_alive(), 1);
+  EXPECT_EQ(s.position(below), resting);  // its last state stays readable
+  s.Step();  // the first half-kick still uses the old contact force
+  const double v1 = s.velocity(above).z();
+  for (int i = 0; i < 100; ++i) s.Step();
+  // free fall: no force but its weight
+  EXPECT_NEAR(s.velocity(above).z() - v1, -9.81 * 100 * s.dt(), 1e-12);
+  EXPECT_EQ(s.contacts(), 0);
+  // its storage is reused by the next particle, under a new ID
+  const int again = s.AddParticle(Vector3d(0, 0, 0.5 * D));
+  EXPECT_EQ(again, 2);
+  EXPECT_TRUE(std::isnan(s.position(below).x()));
+  EXPECT_THROW(s.RemoveParticle(below), ConfigError);
+}
+
+// a moving soil patch in miniature: particles rained into a box and the oldest removed
+DemSystem Stream(int threads, long* adds) {
+  const SoilParams p = Nominal();
+  const double D = p.diameter, L = 8 * D;
+  DemSettings st;
+  st.threads = threads;
+  DemSystem s(p, st);
+  s.AddWall(MakeQuadWall("floor", {0, 0, 0}, {L, 0, 0}, {0, L, 0}));
+  s.AddWall(MakeQuadWall("x0", {0, 0, 0}, {0, 0, L}, {0, L, 0}));
+  s.AddWall(MakeQuadWall("x1", {L, 0, 0}, {0, L, 0}, {0, 0, L}));
+  s.AddWall(MakeQuadWall("y0", {0, 0, 0}, {L, 0, 0}, {0, 0, L}));
+  s.AddWall(MakeQuadWall("y1", {0, L, 0}, {0, 0, L}, {L, 0, 0}));
+  // 25 emission points, each used every 1000 steps, high above the columns that pile up below them
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> jitter(-0.1 * D, 0.1 * D);
+  s.AddParticle(Vector3d(0.5 * L, 0.5 * L, 0.5 * D));
+  s.Finalize(1.5e-5);
+  int oldest = 0;
+  *adds = 0;
+  for (int i = 0; i < 12000; ++i) {
+    if (i % 40 == 0) {
+      const int spot = static_cast<int>(*adds % 25);
+      s.AddParticle(Vector3d((1.2 + 1.4 * (spot % 5)) * D + jitter(rng), (1.2 + 1.4 * (spot / 5)) * D + jitter(rng), 10 * D),
+                    Vector3d(0, 0, -3.0));
+      ++*adds;
+    }
+    if (i % 40 == 20 && s.num_alive() > 100) s.RemoveParticle(oldest++);
+    s.Step();
+  }
+  return s;
+}
+
+TEST(DemParticles, EmitAndRemoveStreamIsDeterministicAcrossThreads) {
+  long adds1, adds2;
+  const DemSystem a = Stream(1, &adds1), b = Stream(2, &adds2);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(a.num_alive(), 100);
+  for (int id = 0; id < a.size(); ++id) {
+    if (!a.alive(id)) continue;
+    ASSERT_EQ(a.position(id), b.position(id)) << "particle " << id;
+    ASSERT_EQ(a.velocity(id), b.velocity(id)) << "particle " << id;
+  }
+  // adding does not rebuild the lists (only a neighbour's full list would)
+  EXPECT_LT(a.overflow_builds(), adds1 / 20) << adds1 << " added, " << a.neighbour_builds() << " builds";
+  const DemEnergy e = a.Energy();
+  EXPECT_GT(e.dissipated, 0.0);
+}
+
+TEST(DemParticles, WallWorkEqualsTheEnergyAPistonGives) {
+  // an undamped frictionless particle bouncing off a wall moving toward it: in the wall's frame
+  // it reverses its speed, so it leaves at 2U - v, and the wall's work is the kinetic energy gained
+  const SoilParams p = Elastic(0.0);
+  const double D = p.diameter, m = p.Mass(), v = -0.2, U = 0.3;
+  DemSystem s(p, DemSettings());
+  s.set_gravity(Vector3d::Zero());
+  const int wall = s.AddWall(MakeQuadWall("piston", {0, -D, -D}, {0, 2 * D, 0}, {0, 0, 2 * D}));
+  const int id = s.AddParticle(Vector3d(0.5 * D + 0.002, 0, 0), Vector3d(v, 0, 0));
+  s.mutable_wall(wall).velocity = Vector3d(U, 0, 0);
+  const double dt = 0.02 * 2.0 * std::sqrt(m / p.NormalStiffness());
+  s.Finalize(dt);
+  double X = 0.0;
+  for (int i = 0; i < 100000; ++i) {
+    X += U * dt;
+    s.mutable_wall(wall).position = Vector3d(X, 0, 0);
+    s.Step();
+    if (s.velocity(id).x() > 0.0 && s.position(id).x() - X > 0.5 * D + 1e-4) break;  // parted
+  }
+  const double v_out = 2 * U - v;
+  EXPECT_NEAR(s.velocity(id).x(), v_out, 1e-3 * v_out);
+  const DemEnergy e = s.Energy();
+  const double gained = 0.5 * m * (v_out * v_out - v * v);
+  EXPECT_NEAR(e.wall_work, gained, 2e-3 * gained);
+  EXPECT_NEAR(e.dissipated, 0.0, 2e-3 * gained);
+}
+
+TEST(DemParticles, DissipationOfADampedCollisionIsTheKineticEnergyLost) {
+  const SoilParams p = Elastic(2.1e4);
+  const double D = p.diameter, m = p.Mass(), v0 = 0.5;
+  const double m_eff = 0.5 * m, k = p.NormalStiffness(), c = p.NormalDamping();
+  const double zeta = c / (2.0 * std::sqrt(k * m_eff));
+  const double e = std::exp(-M_PI * zeta / std::sqrt(1.0 - zeta * zeta));
+  DemSystem s(p, DemSettings());
+  s.set_gravity(Vector3d::Zero());
+  s.AddParticle(Vector3d(-0.5 * D - 1e-4, 0, 0), Vector3d(v0, 0, 0));
+  s.AddParticle(Vector3d(0.5 * D + 1e-4, 0, 0), Vector3d(-v0, 0, 0));
+  s.Finalize(0.02 * 2.0 * std::sqrt(m_eff / k));
+  for (int i = 0; i < 200000 && !(s.position(1).x() - s.position(0).x() > D + 2e-4); ++i) s.Step();
+  const double lost = m * v0 * v0 * (1.0 - e * e);  // two particles, each from v0 to e v0
+  EXPECT_NEAR(s.Energy().dissipated, lost, 0.02 * lost);
+  EXPECT_EQ(s.Energy().wall_work, 0.0);
+}
+
+}  // namespace
+}  // namespace dem_mobility
