@@ -1,8 +1,11 @@
-// dem_step: particle-steps per second of the DEM solver on the reference bed of
-// ../shared/bench/lammps-bed.in (124,800 particles of 3 cm, fcc with nearest neighbours 1 %
-// overlapped, gravity, a floor), with contact history, adhesion and plasticity on (the nominal
-// soil), at 1 and 2 threads. The LAMMPS bed has periodic sides; ours has four side walls.
-//   dem_step_bench [SOIL.yaml] [steps]
+// dem_step: particle-steps per second of the DEM solver at 1 and 2 threads, with contact history,
+// adhesion and plasticity on (the nominal soil), on
+//  (a) the reference bed of ../shared/bench/lammps-bed.in (124,800 particles of 3 cm, fcc with
+//      nearest neighbours 1 % overlapped, gravity, a floor; the LAMMPS bed has periodic sides,
+//      ours four side walls), and
+//  (b) a poured, consolidated cohesive bed of 100,000 particles (config/scenes/dem_bench_bed.yaml,
+//      prepared by the dem_pour scene first; its preparation is timed too).
+//   dem_step_bench [SOIL.yaml] [steps] [BED_B_SCENE.yaml | none]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -10,6 +13,7 @@
 
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_system.h"
+#include "dem_mobility/core/scenes/dem_pour.h"
 
 using namespace dem_mobility;
 using Eigen::Vector3d;
@@ -56,6 +60,15 @@ Figures Run(const SoilParams& soil, int threads, int steps) {
 }
 }  // namespace
 
+double Rate(DemSystem s, int threads, int steps) {  // on a copy
+  s.set_threads(threads);
+  for (int i = 0; i < 20; ++i) s.Step();
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < steps; ++i) s.Step();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return static_cast<double>(s.num_alive()) * steps / wall;
+}
+
 int main(int argc, char** argv) {
   const std::string file = argc > 1 ? argv[1] : DM_CONFIG_DIR "/soils/nominal_clay.yaml";
   const int steps = argc > 2 ? std::stoi(argv[2]) : 1000;
@@ -69,5 +82,23 @@ int main(int argc, char** argv) {
   std::printf("dem_step bed_speedup_1_to_2 %.3f x\n", two.rate / one.rate);
   std::printf("dem_step bed_bytes_per_particle %.0f B\n", two.bytes_per_particle);
   std::fflush(stdout);
+  const std::string bed_b = argc > 3 ? argv[3] : DM_CONFIG_DIR "/scenes/dem_bench_bed.yaml";
+  if (bed_b == "none") return 0;
+  const DemPourParams pp = DemPourParams::Read(YamlReader::Load(bed_b));
+  std::unique_ptr<DemSystem> bed;
+  const DemPourResult prep = RunDemPour(pp, &bed);
+  if (!prep.error.empty()) {
+    std::fprintf(stderr, "dem_step: preparing bed (b) failed: %s\n", prep.error.c_str());
+    return 1;
+  }
+  std::printf("dem_step poured_particles %d count\n", bed->num_alive());
+  std::printf("dem_step poured_preparation %.1f s (%.3f s simulated)\n", prep.wall_time, prep.sim_time);
+  std::printf("dem_step poured_density %.0f kg/m^3\n", prep.density_consolidated);
+  std::printf("dem_step poured_contacts_per_particle %.2f count\n", 2.0 * bed->contacts() / bed->num_alive());
+  const double p1 = Rate(*bed, 1, steps), p2 = Rate(*bed, 2, steps);
+  std::printf("dem_step poured_rate_1thread %.3f Mparticle-steps/s\n", p1 * 1e-6);
+  std::printf("dem_step poured_rate_2threads %.3f Mparticle-steps/s\n", p2 * 1e-6);
+  std::printf("dem_step poured_speedup_1_to_2 %.3f x\n", p2 / p1);
+  std::printf("dem_step poured_bytes_per_particle %.0f B\n", static_cast<double>(bed->MemoryBytes()) / bed->num_alive());
   return 0;
 }

@@ -93,12 +93,9 @@ int DemSystem::AddParticle(const Vector3d& x, const Vector3d& v) {
     alive_.push_back(0);
     slab_of_.push_back(0);
     id_of_slot_.push_back(-1);
-    particle_wall_power_.push_back(0.0);
     const size_t W = walls_.size();
     wall_hist_.resize(wall_hist_.size() + W);
     wall_touching_.resize(wall_touching_.size() + W, 0);
-    wall_force_.resize(wall_force_.size() + W, Vector3d::Zero());
-    wall_moment_.resize(wall_moment_.size() + W, Vector3d::Zero());
     if (finalized_) {
       nbr_begin_.push_back(static_cast<int>(nbr_.size()));
       nbr_end_.push_back(nbr_begin_.back());
@@ -114,13 +111,11 @@ int DemSystem::AddParticle(const Vector3d& x, const Vector3d& v) {
   x_built_[p] = x;
   plastic_[p] = 0.0;
   adhesion_max_[p] = MaxAdhesionForce(soil_, 0.0);
-  max_repulsion_[p] = overlap_[p] = particle_wall_power_[p] = 0.0;
+  max_repulsion_[p] = overlap_[p] = 0.0;
   const size_t W = walls_.size();
   for (size_t w = 0; w < W; ++w) {
     wall_hist_[p * W + w] = TangentialHistory();
     wall_touching_[p * W + w] = 0;
-    wall_force_[p * W + w].setZero();
-    wall_moment_[p * W + w].setZero();
   }
   if (!finalized_) {  // the first build lists it
     alive_[p] = 1;
@@ -151,16 +146,19 @@ void DemSystem::RemoveParticle(int id) {
     for (size_t w = 0; w < W; ++w) {
       wall_hist_[i * W + w] = TangentialHistory();
       wall_touching_[i * W + w] = 0;
-      wall_force_[i * W + w].setZero();
-      wall_moment_[i * W + w].setZero();
     }
   }
   alive_[i] = 0;
   f_[i].setZero();
-  max_repulsion_[i] = overlap_[i] = particle_wall_power_[i] = 0.0;
+  max_repulsion_[i] = overlap_[i] = 0.0;
   slot_of_id_[id] = -2 - i;  // removed; its last state stays readable until the slot is reused
   ++removed_;
   free_slots_.insert(std::lower_bound(free_slots_.begin(), free_slots_.end(), i), i);
+}
+
+void DemSystem::set_threads(int threads) {
+  DM_THROW_UNLESS(threads >= 1, "DEM threads ", threads, " must be >= 1");
+  settings_.threads = threads;
 }
 
 int DemSystem::LiveSlot(int id) const {
@@ -248,7 +246,6 @@ void DemSystem::SortSlots(const std::vector<long>& cell) {
   permute(overlap_, 1);
   permute(alive_, 1);
   permute(id_of_slot_, 1);
-  permute(particle_wall_power_, 1);
   permute(wall_hist_, walls_.size());
   permute(wall_touching_, walls_.size());
   // the old neighbour lists stay where they are, reached through the old slot numbers
@@ -416,8 +413,6 @@ void DemSystem::BuildNeighbours() {
   for (int i = 0; i < n; ++i) particle_tri_start_[i + 1] = particle_tri_start_[i] + static_cast<int>(cand[i].size());
   particle_tris_.resize(particle_tri_start_[n]);
   for (int i = 0; i < n; ++i) std::copy(cand[i].begin(), cand[i].end(), particle_tris_.begin() + particle_tri_start_[i]);
-  wall_force_.assign(static_cast<size_t>(n) * W, Vector3d::Zero());
-  wall_moment_.assign(static_cast<size_t>(n) * W, Vector3d::Zero());
   rebuild_ = false;
   ++builds_;
 }
@@ -622,97 +617,91 @@ void DemSystem::ComputeForces() {
     return;
   }
   // walls: per wall the deepest of the candidate triangles (a particle added since the last build
-  // tries them all)
-#pragma omp parallel for schedule(static) num_threads(T)
-  for (int i = 0; i < n; ++i) {
-    if (!alive_[i]) continue;
-    const bool fresh = alive_[i] == 2;
-    const int t_begin = fresh ? 0 : particle_tri_start_[i], t_end = fresh ? all_tris : particle_tri_start_[i + 1];
-    double power = 0.0;
-    if (t_begin == t_end) {  // no wall near: clear what an earlier contact left
-      for (int w = 0; w < W; ++w) {
-        const size_t hw = static_cast<size_t>(i) * W + w;
-        if (wall_touching_[hw]) {
-          wall_hist_[hw] = TangentialHistory();
-          wall_touching_[hw] = 0;
-          wall_force_[hw].setZero();
-          wall_moment_[hw].setZero();
+  // tries them all). The wrenches are summed in fixed chunks of slots, in slot order, and the chunks
+  // in order: the same sums for any thread count, without a force per particle and wall.
+  constexpr int kChunk = 4096;
+  const int chunks = (n + kChunk - 1) / kChunk;
+  wall_chunk_.assign(static_cast<size_t>(chunks) * W, WallSum());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(T)
+  for (int c = 0; c < chunks; ++c) {
+    WallSum* sum = &wall_chunk_[static_cast<size_t>(c) * W];
+    for (int i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
+      if (!alive_[i]) continue;
+      const bool fresh = alive_[i] == 2;
+      const int t_begin = fresh ? 0 : particle_tri_start_[i], t_end = fresh ? all_tris : particle_tri_start_[i + 1];
+      if (t_begin == t_end) {  // no wall near: clear what an earlier contact left
+        for (int w = 0; w < W; ++w) {
+          const size_t hw = static_cast<size_t>(i) * W + w;
+          if (wall_touching_[hw]) {
+            wall_hist_[hw] = TangentialHistory();
+            wall_touching_[hw] = 0;
+          }
         }
-      }
-      particle_wall_power_[i] = 0.0;
-      continue;
-    }
-    const Vector3d xi = x_[i], vi = v_[i];
-    const double pi = plastic_[i], ai = adhesion_max_[i];
-    Vector3d f = f_[i];
-    double max_rep = max_repulsion_[i], max_overlap = overlap_[i];
-    for (int w = 0; w < W; ++w) {
-      const size_t hw = static_cast<size_t>(i) * W + w;
-      wall_force_[hw].setZero();
-      wall_moment_[hw].setZero();
-      const DemWall& wl = walls_[w];
-      double best = 0.0;
-      Vector3d q_best = Vector3d::Zero();
-      for (int t = t_begin; t < t_end; ++t) {
-        const WallTri& tr = wall_tris_[fresh ? t : particle_tris_[t]];
-        if (tr.wall != w) continue;
-        // the triangle where the wall is now (it may have moved since the build)
-        const auto& face = wl.mesh.faces[tr.face];
-        const std::vector<Vector3d>& wv = wall_vertices_[w];
-        const Vector3d q = ClosestPointOnTriangle(xi, wv[face[0]], wv[face[1]], wv[face[2]]);
-        const double overlap = 0.5 * D - (xi - q).norm();
-        if (overlap > best) {
-          best = overlap;
-          q_best = q;
-        }
-      }
-      const double d = best - pi;
-      if (!(d > 0.0)) {
-        wall_hist_[hw] = TangentialHistory();
-        wall_touching_[hw] = 0;
         continue;
       }
-      max_overlap = std::max(max_overlap, best);
-      const Vector3d r = xi - q_best;
-      const Vector3d nrm = r / r.norm();
-      const Vector3d vw = wl.velocity + wl.angular_velocity.cross(q_best - wl.position);
-      const Vector3d vr = vi - vw;
-      const double vn = vr.dot(nrm);
-      const SoilContactLaw& wlaw = wall_law_[w];
-      const SoilNormalForce fn = wlaw.Normal(d, -vn, wl.adhesion_factor * ai);
-      const Vector3d ft = wlaw.Tangential(nrm, vr - vn * nrm, fn.repulsion, dt, &wall_hist_[hw]);
-      const Vector3d fc = fn.Total() * nrm + ft;
-      f += fc;
-      power += fc.dot(vw);  // the wall's work on the particle, per unit time
-      max_rep = std::max(max_rep, fn.repulsion);
-      wall_touching_[hw] = 1;
-      wall_force_[hw] = -fc;
-      wall_moment_[hw] = (q_best - wl.wrench_point).cross(-fc);
+      const Vector3d xi = x_[i], vi = v_[i];
+      const double pi = plastic_[i], ai = adhesion_max_[i];
+      Vector3d f = f_[i];
+      double max_rep = max_repulsion_[i], max_overlap = overlap_[i];
+      for (int w = 0; w < W; ++w) {
+        const size_t hw = static_cast<size_t>(i) * W + w;
+        const DemWall& wl = walls_[w];
+        double best = 0.0;
+        Vector3d q_best = Vector3d::Zero();
+        for (int t = t_begin; t < t_end; ++t) {
+          const WallTri& tr = wall_tris_[fresh ? t : particle_tris_[t]];
+          if (tr.wall != w) continue;
+          // the triangle where the wall is now (it may have moved since the build)
+          const auto& face = wl.mesh.faces[tr.face];
+          const std::vector<Vector3d>& wv = wall_vertices_[w];
+          const Vector3d q = ClosestPointOnTriangle(xi, wv[face[0]], wv[face[1]], wv[face[2]]);
+          const double overlap = 0.5 * D - (xi - q).norm();
+          if (overlap > best) {
+            best = overlap;
+            q_best = q;
+          }
+        }
+        const double d = best - pi;
+        if (!(d > 0.0)) {
+          wall_hist_[hw] = TangentialHistory();
+          wall_touching_[hw] = 0;
+          continue;
+        }
+        max_overlap = std::max(max_overlap, best);
+        const Vector3d r = xi - q_best;
+        const Vector3d nrm = r / r.norm();
+        const Vector3d vw = wl.velocity + wl.angular_velocity.cross(q_best - wl.position);
+        const Vector3d vr = vi - vw;
+        const double vn = vr.dot(nrm);
+        const SoilContactLaw& wlaw = wall_law_[w];
+        const SoilNormalForce fn = wlaw.Normal(d, -vn, wl.adhesion_factor * ai);
+        const Vector3d ft = wlaw.Tangential(nrm, vr - vn * nrm, fn.repulsion, dt, &wall_hist_[hw]);
+        const Vector3d fc = fn.Total() * nrm + ft;
+        f += fc;
+        max_rep = std::max(max_rep, fn.repulsion);
+        wall_touching_[hw] = 1;
+        sum[w].force -= fc;
+        sum[w].moment += (q_best - wl.wrench_point).cross(-fc);
+        sum[w].power += fc.dot(vw);  // the wall's work on the particle, per unit time
+        ++sum[w].contacts;
+      }
+      f_[i] = f;
+      max_repulsion_[i] = max_rep;
+      overlap_[i] = max_overlap;
     }
-    f_[i] = f;
-    max_repulsion_[i] = max_rep;
-    overlap_[i] = max_overlap;
-    particle_wall_power_[i] = power;
   }
-  ComputeWallForces();
-}
-
-void DemSystem::ComputeWallForces() {
-  // summed in slot order, whatever the thread count
-  const int W = num_walls(), n = static_cast<int>(x_.size());
   wall_power_ = 0.0;
-  for (int i = 0; i < n; ++i) wall_power_ += particle_wall_power_[i];
   for (int w = 0; w < W; ++w) {
     DemWall& wl = walls_[w];
     wl.force.setZero();
     wl.moment.setZero();
     wl.contacts = 0;
-    for (int i = 0; i < n; ++i) {
-      const size_t hw = static_cast<size_t>(i) * W + w;
-      if (!wall_touching_[hw]) continue;
-      wl.force += wall_force_[hw];
-      wl.moment += wall_moment_[hw];
-      ++wl.contacts;
+    for (int c = 0; c < chunks; ++c) {
+      const WallSum& cs = wall_chunk_[static_cast<size_t>(c) * W + w];
+      wl.force += cs.force;
+      wl.moment += cs.moment;
+      wl.contacts += cs.contacts;
+      wall_power_ += cs.power;
     }
   }
 }
@@ -840,8 +829,8 @@ size_t DemSystem::MemoryBytes() const {
              bytes(max_repulsion_) + bytes(overlap_) + bytes(alive_) + bytes(id_of_slot_) + bytes(slot_of_id_) +
              bytes(free_slots_) + bytes(nbr_begin_) + bytes(nbr_end_) + bytes(nbr_cap_) + bytes(nbr_) +
              bytes(hist_) + bytes(touching_) + bytes(cell_start_) + bytes(added_since_build_) + bytes(slab_of_) +
-             bytes(slab_start_) + bytes(particle_wall_power_) + bytes(wall_hist_) + bytes(wall_touching_) +
-             bytes(particle_tri_start_) + bytes(particle_tris_) + bytes(wall_force_) + bytes(wall_moment_);
+             bytes(slab_start_) + bytes(wall_hist_) + bytes(wall_touching_) + bytes(particle_tri_start_) +
+             bytes(particle_tris_) + bytes(wall_chunk_);
   for (const auto& a : slab_added_) b += bytes(a);
   return b;
 }

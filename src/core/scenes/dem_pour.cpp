@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <memory>
 #include <random>
 
 #include <yaml-cpp/yaml.h>
@@ -47,7 +48,7 @@ DemPourParams DemPourParams::Read(const YamlReader& y) {
 double LayerHeight(const DemSystem& s) {
   std::vector<double> z;
   z.reserve(s.size());
-  for (const Vector3d& x : s.positions()) z.push_back(x.z());
+  s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) { z.push_back(x.z()); });
   if (z.empty()) return 0.0;
   const size_t top = std::max<size_t>(1, z.size() / 20);
   std::partial_sort(z.begin(), z.begin() + top, z.end(), std::greater<double>());
@@ -56,13 +57,14 @@ double LayerHeight(const DemSystem& s) {
   return sum / top + 0.5 * s.soil().diameter;
 }
 
-DemPourResult RunDemPour(const DemPourParams& p) {
+DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* keep) {
   DemPourResult r;
   const auto wall0 = std::chrono::steady_clock::now();
   const double D = p.soil.diameter, L = p.box_length, W = p.box_width;
   DemSettings st;
   st.threads = p.threads;
-  DemSystem s(p.soil, st);
+  auto system = std::make_unique<DemSystem>(p.soil, st);
+  DemSystem& s = *system;
   // a loose lattice (spacing 1.2 d) over the box, as many layers as it takes, jittered: it falls
   // and settles as a poured bed
   const double a = 1.2 * D;
@@ -96,23 +98,24 @@ DemPourResult RunDemPour(const DemPourParams& p) {
     run_for(p.settle_time);
     r.height_poured = LayerHeight(s);
     r.density_poured = mass / (area * r.height_poured);
-    // the lid is a piston pressed down with the target force: a body of the particles' mass, damped
-    // critically against the stiffness of one layer of contacts, its speed capped at lid_speed;
-    // the hold time counts from when the particles first carry 95 % of the force
+    // the lid is driven down at a speed proportional to the force it still lacks (up to
+    // lid_speed), so it settles on the target pressure. The loop gain per step is
+    // v_max dt k_layer / target (k_layer: one layer of contacts under the lid); v_max is capped so
+    // that it stays at most 0.5 and the force converges without overshoot. The hold time counts
+    // from when the particles first carry 95 % of the force.
     const double target = p.lid_pressure * area;
     DemWall& lw = s.mutable_wall(lid_index);
     double z_top = 0.0;
-    for (const Vector3d& x : s.positions()) z_top = std::max(z_top, x.z());
+    s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) { z_top = std::max(z_top, x.z()); });
     lw.position.z() = z_top + 0.6 * D;  // just clear of the highest particle
-    const double m_lid = mass, k_layer = area / (D * D) * p.soil.NormalStiffness();
-    const double c_lid = 2.0 * std::sqrt(k_layer * m_lid);
-    double v = 0.0, held = -1.0, pressure_sum = 0.0;
+    const double k_layer = area / (D * D) * p.soil.NormalStiffness();
+    const double v_max = std::min(p.lid_speed, 0.5 * target / (p.time_step * k_layer));
+    double held = -1.0, pressure_sum = 0.0;
     long hold_steps = 0;
     const double t_limit = s.time() + 60.0;
     while (held < p.hold_time) {
       const double fz = s.wall(lid_index).force.z();  // the particles push the lid up
-      v += p.time_step * (fz - target - c_lid * v) / m_lid;
-      v = std::max(v, -p.lid_speed);
+      const double v = std::clamp(-v_max * (target - fz) / target, -v_max, v_max);
       lw.velocity = Vector3d(0, 0, v);
       lw.position.z() += v * p.time_step;
       s.Step();
@@ -128,7 +131,7 @@ DemPourResult RunDemPour(const DemPourParams& p) {
     // the lid goes back up at lid_speed until it is one diameter clear of every particle, then away
     for (;;) {
       double top = 0.0;
-      for (const Vector3d& x : s.positions()) top = std::max(top, x.z());
+      s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) { top = std::max(top, x.z()); });
       if (lw.position.z() > top + 0.6 * D && s.wall(lid_index).contacts == 0) break;
       lw.velocity = Vector3d(0, 0, p.lid_speed);
       lw.position.z() += p.lid_speed * p.time_step;
@@ -149,6 +152,7 @@ DemPourResult RunDemPour(const DemPourParams& p) {
   r.steps = s.step_count();
   r.sim_time = s.time();
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (keep) *keep = std::move(system);
   return r;
 }
 

@@ -124,6 +124,14 @@ class DemSystem {
   double plastic_deformation(int id) const { return Get(plastic_, id); }
   Eigen::Vector3d& mutable_velocity(int id) { return v_[LiveSlot(id)]; }
   Eigen::Vector3d& mutable_position(int id) { return x_[LiveSlot(id)]; }
+  /// Calls f(id, position, velocity) for every live particle, in storage order (cheap: no copies).
+  template <class F>
+  void ForEachParticle(F&& f) const {
+    for (size_t s = 0; s < x_.size(); ++s)
+      if (alive_[s]) f(id_of_slot_[s], x_[s], v_[s]);
+  }
+  /// OpenMP threads from the next step on (the results do not depend on it).
+  void set_threads(int threads);
   // all particles, indexed by ID (copies: the storage is kept sorted by cell, not by ID)
   std::vector<Eigen::Vector3d> positions() const;
   std::vector<Eigen::Vector3d> velocities() const;
@@ -167,7 +175,6 @@ class DemSystem {
   double ParticleEnergy(int i) const;
   double PairEnergy(int i, int k) const;
   void ComputeForces();
-  void ComputeWallForces();
   void UpdateWallVertices();
   double MaxWallDisplacement() const;
   void CheckState() const;
@@ -214,7 +221,6 @@ class DemSystem {
   std::vector<int> NeighbourCandidates(const Eigen::Vector3d& x) const;
   // the energy ledger
   double e0_ = 0.0, wall_work_ = 0.0, exchanged_ = 0.0, wall_power_ = 0.0;
-  std::vector<double> particle_wall_power_;
   // walls: world triangles at the last build; per slot the candidate triangles, and per slot and
   // wall one tangential history
   std::vector<DemWall> walls_;
@@ -227,7 +233,12 @@ class DemSystem {
   std::vector<std::vector<Eigen::Vector3d>> wall_vertices_, wall_built_vertices_;  ///< world
   std::vector<WallTri> wall_tris_;
   std::vector<int> particle_tri_start_, particle_tris_;  ///< CSR: candidate wall triangles per slot
-  std::vector<Eigen::Vector3d> wall_force_, wall_moment_;  ///< per slot and wall, summed per wall
+  struct WallSum {
+    Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+    double power = 0.0;
+    int contacts = 0;
+  };
+  std::vector<WallSum> wall_chunk_;  ///< per chunk of slots and wall
 };
 
 }  // namespace dem_mobility

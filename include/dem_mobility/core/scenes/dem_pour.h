@@ -3,6 +3,7 @@
 // result is the bulk density and the layer height before and after the consolidation.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "dem_mobility/core/dem/dem_system.h"
@@ -39,8 +40,8 @@ struct DemPourResult {
 };
 
 /// Runs the pour, settle, consolidate and release; numerical failures end it with `error` set and
-/// the figures measured so far.
-DemPourResult RunDemPour(const DemPourParams& p);
+/// the figures measured so far. With `keep`, the prepared bed is handed over (to run on).
+DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* keep = nullptr);
 void WriteDemPourResult(const DemPourResult& r, const DemPourParams& p, const std::string& path);
 
 /// Height of a particle layer: the mean top of the highest 5 % of the particles.
