@@ -19,14 +19,10 @@ using namespace dem_mobility;
 using Eigen::Vector3d;
 
 namespace {
-struct Figures {
-  double rate, bytes_per_particle;
-  int particles, contacts;
-};
-
-Figures Run(const SoilParams& soil, int threads, int steps) {
+// bed (a), finalized and run the 200 steps the LAMMPS input runs before its timed 1000
+DemSystem ReferenceBed(const SoilParams& soil) {
   DemSettings st;
-  st.threads = threads;
+  st.threads = 2;
   DemSystem s(soil, st);
   const double a = 0.042;  // fcc lattice constant: nearest neighbours at a / sqrt(2) = 0.0297 m
   const int nx = 60, ny = 40;
@@ -47,20 +43,12 @@ Figures Run(const SoilParams& soil, int threads, int steps) {
           s.AddParticle(x);
         }
   s.Finalize(1.5e-5);
-  for (int i = 0; i < 200; ++i) s.Step();  // as the LAMMPS input: 200 steps, then the timed 1000
-  const auto t0 = std::chrono::steady_clock::now();
-  for (int i = 0; i < steps; ++i) s.Step();
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  Figures f;
-  f.particles = s.size();
-  f.contacts = s.contacts();
-  f.rate = static_cast<double>(s.size()) * steps / wall;
-  f.bytes_per_particle = static_cast<double>(s.MemoryBytes()) / s.size();
-  return f;
+  for (int i = 0; i < 200; ++i) s.Step();
+  return s;
 }
-}  // namespace
 
-double Rate(DemSystem s, int threads, int steps) {  // on a copy
+// particle-steps per second over `steps` timed steps of a copy of `s`, after 20 more warm-up steps
+double Rate(DemSystem s, int threads, int steps) {
   s.set_threads(threads);
   for (int i = 0; i < 20; ++i) s.Step();
   const auto t0 = std::chrono::steady_clock::now();
@@ -68,19 +56,20 @@ double Rate(DemSystem s, int threads, int steps) {  // on a copy
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return static_cast<double>(s.num_alive()) * steps / wall;
 }
+}  // namespace
 
 int main(int argc, char** argv) {
   const std::string file = argc > 1 ? argv[1] : DM_CONFIG_DIR "/soils/nominal_clay.yaml";
   const int steps = argc > 2 ? std::stoi(argv[2]) : 1000;
   const SoilParams soil = SoilParams::Read(YamlReader::Load(file));
-  const Figures one = Run(soil, 1, steps);
-  std::printf("dem_step bed_particles %d count\n", one.particles);
-  std::printf("dem_step bed_contacts %d count\n", one.contacts);
-  std::printf("dem_step bed_rate_1thread %.3f Mparticle-steps/s\n", one.rate * 1e-6);
-  const Figures two = Run(soil, 2, steps);
-  std::printf("dem_step bed_rate_2threads %.3f Mparticle-steps/s\n", two.rate * 1e-6);
-  std::printf("dem_step bed_speedup_1_to_2 %.3f x\n", two.rate / one.rate);
-  std::printf("dem_step bed_bytes_per_particle %.0f B\n", two.bytes_per_particle);
+  const DemSystem bed_a = ReferenceBed(soil);
+  std::printf("dem_step bed_particles %d count\n", bed_a.num_alive());
+  std::printf("dem_step bed_contacts %d count\n", bed_a.contacts());
+  const double a1 = Rate(bed_a, 1, steps), a2 = Rate(bed_a, 2, steps);
+  std::printf("dem_step bed_rate_1thread %.3f Mparticle-steps/s\n", a1 * 1e-6);
+  std::printf("dem_step bed_rate_2threads %.3f Mparticle-steps/s\n", a2 * 1e-6);
+  std::printf("dem_step bed_speedup_1_to_2 %.3f x\n", a2 / a1);
+  std::printf("dem_step bed_bytes_per_particle %.0f B\n", static_cast<double>(bed_a.MemoryBytes()) / bed_a.num_alive());
   std::fflush(stdout);
   const std::string bed_b = argc > 3 ? argv[3] : DM_CONFIG_DIR "/scenes/dem_bench_bed.yaml";
   if (bed_b == "none") return 0;

@@ -7,26 +7,13 @@
 #include <cmath>
 #include <random>
 
-#include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_system.h"
+#include "dem_test_soils.h"
 
 namespace dem_mobility {
 namespace {
 
 using Eigen::Vector3d;
-
-SoilParams Nominal() { return SoilParams::Read(YamlReader::Load(DM_CONFIG_DIR "/soils/nominal_clay.yaml")); }
-
-SoilParams Elastic(double damping_area) {
-  SoilParams p = Nominal();
-  p.cohesion = false;
-  p.plasticity = false;
-  p.adhesion_depth = p.adhesion_peak = 0.0;
-  p.friction = 0.0;
-  p.damping_area = damping_area;
-  p.separation_factor = 1.0;
-  return p;
-}
 
 // a 6 x 6 x 3 lattice of cohesive particles on a floor, touching (1 % overlap), settled a little
 DemSystem SmallBed(int slack, int threads) {

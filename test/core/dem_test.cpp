@@ -6,27 +6,13 @@
 #include <random>
 
 #include "dem_mobility/core/common/error.h"
-#include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_system.h"
+#include "dem_test_soils.h"
 
 namespace dem_mobility {
 namespace {
 
 using Eigen::Vector3d;
-
-SoilParams Nominal() { return SoilParams::Read(YamlReader::Load(DM_CONFIG_DIR "/soils/nominal_clay.yaml")); }
-
-// a plain linear spring-dashpot: no adhesion, no plasticity, no friction
-SoilParams Elastic(double damping_area) {
-  SoilParams p = Nominal();
-  p.cohesion = false;
-  p.plasticity = false;
-  p.adhesion_depth = p.adhesion_peak = 0.0;
-  p.friction = 0.0;
-  p.damping_area = damping_area;
-  p.separation_factor = 1.0;
-  return p;
-}
 
 // two particles meeting head-on at +-v0; returns the speed after they part
 double Collide(const SoilParams& p, double v0, double dt_fraction) {

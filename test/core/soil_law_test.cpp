@@ -6,11 +6,11 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/soil_law.h"
+#include "dem_test_soils.h"
 
 namespace dem_mobility {
 namespace {
 
-SoilParams Nominal() { return SoilParams::Read(YamlReader::Load(DM_CONFIG_DIR "/soils/nominal_clay.yaml")); }
 
 // table 2: stiffness 4.42e7 N/m^2 (stress per strain) and damping 2.1e4 N s/m^3 on the area of a
 // 3 cm particle; these are the numbers the law must use

@@ -201,16 +201,9 @@ Eigen::Vector3i DemSystem::CellOf(const Vector3d& x) const {
 std::vector<int> DemSystem::NeighbourCandidates(const Vector3d& x) const {
   // the slots of the last build in the 27 cells about x, and those added since
   std::vector<int> out;
-  const Eigen::Vector3i c = CellOf(x);
-  Eigen::Vector3i q;
-  for (q.z() = c.z() - 1; q.z() <= c.z() + 1; ++q.z())
-    for (q.y() = c.y() - 1; q.y() <= c.y() + 1; ++q.y())
-      for (q.x() = c.x() - 1; q.x() <= c.x() + 1; ++q.x()) {
-        if ((q.array() < 0).any() || (q.array() >= grid_dims_.array()).any()) continue;
-        const long cell = CellIndex(q);
-        for (int j = cell_start_[cell]; j < cell_start_[cell + 1]; ++j)
-          if (alive_[j] == 1) out.push_back(j);
-      }
+  ForEachSlotNear(CellOf(x), [&](int j) {
+    if (alive_[j] == 1) out.push_back(j);
+  });
   for (int j : added_since_build_)
     if (alive_[j] == 2) out.push_back(j);
   return out;
@@ -335,17 +328,10 @@ void DemSystem::BuildNeighbours() {
   std::vector<std::vector<int>> found(live);
 #pragma omp parallel for schedule(static) num_threads(settings_.threads)
   for (int i = 0; i < live; ++i) {
-    const Eigen::Vector3i c = CellOf(x_[i]);
     std::vector<int>& out = found[i];
-    Eigen::Vector3i q;
-    for (q.z() = c.z() - 1; q.z() <= c.z() + 1; ++q.z())
-      for (q.y() = c.y() - 1; q.y() <= c.y() + 1; ++q.y())
-        for (q.x() = c.x() - 1; q.x() <= c.x() + 1; ++q.x()) {
-          if ((q.array() < 0).any() || (q.array() >= grid_dims_.array()).any()) continue;
-          const long cq = CellIndex(q);
-          for (int j = cell_start_[cq]; j < cell_start_[cq + 1]; ++j)
-            if (j != i && Owns(i, j) && (x_[i] - x_[j]).squaredNorm() < cut2) out.push_back(j);
-        }
+    ForEachSlotNear(CellOf(x_[i]), [&](int j) {
+      if (j != i && Owns(i, j) && (x_[i] - x_[j]).squaredNorm() < cut2) out.push_back(j);
+    });
     std::sort(out.begin(), out.end());
   }
   // the lists in slot order, each with room for settings_.list_slack more

@@ -219,6 +219,18 @@ class DemSystem {
   }
   bool Owns(int i, int j) const { return slab_of_[i] < slab_of_[j] || (slab_of_[i] == slab_of_[j] && i < j); }
   std::vector<int> NeighbourCandidates(const Eigen::Vector3d& x) const;
+  /// Calls f(slot) for every slot the last build put in the 27 cells about cell c.
+  template <class F>
+  void ForEachSlotNear(const Eigen::Vector3i& c, F&& f) const {
+    Eigen::Vector3i q;
+    for (q.z() = c.z() - 1; q.z() <= c.z() + 1; ++q.z())
+      for (q.y() = c.y() - 1; q.y() <= c.y() + 1; ++q.y())
+        for (q.x() = c.x() - 1; q.x() <= c.x() + 1; ++q.x()) {
+          if ((q.array() < 0).any() || (q.array() >= grid_dims_.array()).any()) continue;
+          const long cell = CellIndex(q);
+          for (int j = cell_start_[cell]; j < cell_start_[cell + 1]; ++j) f(j);
+        }
+  }
   // the energy ledger
   double e0_ = 0.0, wall_work_ = 0.0, exchanged_ = 0.0, wall_power_ = 0.0;
   // walls: world triangles at the last build; per slot the candidate triangles, and per slot and
