@@ -1,7 +1,7 @@
 # The ROS layer: messages of the lock-step exchange and results, the nodelets (thin wrappers over
 # dm_core), launch files and ROS tests. The core (src/core) never sees any of this.
 find_package(catkin REQUIRED COMPONENTS geometry_msgs message_generation nav_msgs nodelet pluginlib rosbag
-  rosgraph_msgs roscpp std_msgs tf2_msgs topic_tools visualization_msgs)
+  rosgraph_msgs roscpp sensor_msgs std_msgs tf2_msgs topic_tools visualization_msgs)
 
 add_message_files(DIRECTORY msg FILES
   WheelStates.msg
@@ -9,13 +9,15 @@ add_message_files(DIRECTORY msg FILES
   DriverInput.msg
   DriverCommand.msg
   MobilityResult.msg
+  ConePenetration.msg
+  ConeIndexResult.msg
 )
 generate_messages(DEPENDENCIES std_msgs geometry_msgs)
 
 catkin_package(
   INCLUDE_DIRS include
   LIBRARIES ${PROJECT_NAME}_nodelets
-  CATKIN_DEPENDS geometry_msgs message_runtime nav_msgs nodelet pluginlib rosbag rosgraph_msgs roscpp std_msgs
+  CATKIN_DEPENDS geometry_msgs message_runtime nav_msgs nodelet pluginlib rosbag rosgraph_msgs roscpp sensor_msgs std_msgs
     tf2_msgs topic_tools visualization_msgs
 )
 install(DIRECTORY include/${PROJECT_NAME}/ DESTINATION ${CATKIN_PACKAGE_INCLUDE_DESTINATION})
@@ -26,6 +28,7 @@ if(CATKIN_ENABLE_TESTING)
   find_package(roslaunch REQUIRED)
   # every launch file parses and finds its packages and files
   roslaunch_add_file_check(launch/road_slope.launch)
+  roslaunch_add_file_check(launch/cone_penetrometer.launch)
   roslaunch_add_file_check(launch/replay.launch bag:=/tmp/run.bag)
   roslaunch_add_file_check(launch/components/vehicle.launch)
   roslaunch_add_file_check(launch/components/terrain.launch)

@@ -145,7 +145,9 @@ void Flatten(const XmlRpc::XmlRpcValue& v, const std::string& prefix, std::vecto
 }
 }  // namespace
 
-RoadSceneParams LoadScene(const ros::NodeHandle& nh) {
+RoadSceneParams LoadScene(const ros::NodeHandle& nh) { return RoadSceneParams::Read(LoadSceneFile(nh)); }
+
+YamlReader LoadSceneFile(const ros::NodeHandle& nh) {
   std::string file;
   if (!nh.getParam("scene", file) || file.empty())
     throw ConfigError("parameter " + nh.resolveName("scene") + " (the scene file) is not set");
@@ -153,7 +155,7 @@ RoadSceneParams LoadScene(const ros::NodeHandle& nh) {
   XmlRpc::XmlRpcValue o;
   if (nh.getParam("override", o)) Flatten(o, "", &overrides);
   // relative paths in overrides (vehicle:=, terrain:=) are the user's, relative to where they ran
-  return RoadSceneParams::Read(YamlReader::LoadWithOverrides(file, overrides));
+  return YamlReader::LoadWithOverrides(file, overrides);
 }
 
 ExchangeTiming LoadExchangeTiming(const ros::NodeHandle& pnh, std::string* transport) {

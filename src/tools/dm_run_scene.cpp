@@ -18,6 +18,7 @@
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/scenes/cone_penetrometer.h"
 #include "dem_mobility/core/scenes/dem_pour.h"
 #include "dem_mobility/core/scenes/road_scene.h"
 
@@ -51,6 +52,48 @@ int RunPour(const YamlReader& reader, const std::string& out_file) {
   return 0;
 }
 
+// The cone penetrometer: preparation, then the cone driven down; prints the cone index.
+int RunCone(const YamlReader& reader, const std::string& out_file, bool quiet) {
+  const ConeParams p = ConeParams::Read(reader);
+  std::printf("scene %s: level '%s', f %.4g, mu %.3g, %d particles of %.3g m in a %.3g m container, cone at %.3g m/s, "
+              "dt %.3g s, %d thread(s)\n",
+              p.file.c_str(), p.level.name.c_str(), p.cohesion_factor, p.friction, p.ParticleCount(),
+              p.level.particle_diameter, p.level.container_diameter, p.level.cone_speed, p.level.time_step, p.threads);
+  std::fflush(stdout);
+  ConePenetrometer scene(p);
+  const auto t0 = std::chrono::steady_clock::now();
+  double next = 2.0;
+  const ConeResult r = scene.Run(
+      [&](const ConePenetrometer& c) {
+        if (quiet) return;
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (wall < next) return;
+        next = wall + 2.0;
+        if (c.phase() == ConePenetrometer::Phase::kPenetrate && !c.samples().empty())
+          std::printf("  %7.1f s wall  t = %.3f s  %-11s tip depth %.3f / %.3f m  CI %.1f psi\n", wall, c.dem().time(),
+                      ConePenetrometer::PhaseName(c.phase()), c.tip_depth(), p.level.ci_to, c.samples().back().ci_psi);
+        else
+          std::printf("  %7.1f s wall  t = %.3f s  %-11s\n", wall, c.dem().time(), ConePenetrometer::PhaseName(c.phase()));
+        std::fflush(stdout);
+      },
+      500);
+  if (!out_file.empty()) WriteConeResult(r, p, out_file);
+  std::printf("prepared: surface %.3f m, bulk density %.1f -> %.1f kg/m^3, lid %.1f kPa held\n", r.surface_height,
+              r.density_poured, r.density_consolidated, r.lid_pressure_reached * 1e-3);
+  std::printf("cone_index: %.2f psi (std %.2f, trend %.1f psi/m over tip depths %.3g-%.3g m, %d samples); cone speed "
+              "%.4f-%.4f m/s\n",
+              r.ci_psi, r.ci_std_psi, r.ci_trend_psi_per_m, p.level.ci_from, p.level.ci_to, r.window_samples,
+              r.speed_min, r.speed_max);
+  std::printf("run: %ld steps, %.3f s simulated (%.3f s preparation) in %.1f s wall\n", r.steps, r.sim_time,
+              r.prep_time, r.wall_time);
+  if (!r.error.empty()) {
+    std::cerr << "dm_run_scene: simulation error: " << r.error << "\n";
+    if (!out_file.empty()) std::cerr << "dm_run_scene: the results so far are in " << out_file << "\n";
+    return 3;
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
   if (argc < 2) return Usage();
   std::string scene_file = argv[1], out_file, history_file;
@@ -77,7 +120,9 @@ int main(int argc, char** argv) {
       if (!parent.empty()) std::filesystem::create_directories(parent, ec);
       if (!std::ofstream(f, std::ios::app)) throw ConfigError(f + ": cannot write the result file here");
     }
-    if (reader.Has("scene") && reader.String("scene") == "dem_pour") return RunPour(reader, out_file);
+    const std::string kind = reader.Has("scene") ? reader.String("scene") : "";
+    if (kind == "dem_pour") return RunPour(reader, out_file);
+    if (kind == "cone_penetrometer") return RunCone(reader, out_file, quiet);
     params = RoadSceneParams::Read(reader);
     scene = std::make_unique<RoadScene>(params);
   } catch (const ConfigError& e) {

@@ -11,6 +11,7 @@
 #include "dem_mobility/DriverInput.h"
 #include "dem_mobility/WheelStates.h"
 #include "dem_mobility/WheelWrenches.h"
+#include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/cosim/exchange.h"
 #include "dem_mobility/core/scenes/road_scene.h"
 #include "dem_mobility/ros/lockstep.h"
@@ -31,6 +32,8 @@ DriveCommand FromMsg(const DriverCommand& m);
 /// empty strings are unset), applied as dotted key=value overrides. Throws ConfigError naming the
 /// file (or the parameter).
 RoadSceneParams LoadScene(const ros::NodeHandle& nh);
+/// The same scene file with its overrides applied, for any kind of scene.
+YamlReader LoadSceneFile(const ros::NodeHandle& nh);
 /// The exchange settings of a nodelet: `exchange_transport`, `exchange_spin` [s],
 /// `peer_timeout` [s], `startup_timeout` [s].
 ExchangeTiming LoadExchangeTiming(const ros::NodeHandle& pnh, std::string* transport);

@@ -200,6 +200,12 @@ Table1D YamlReader::Table(const std::string& key) const {
   }
 }
 
+std::vector<std::string> YamlReader::Keys() const {
+  std::vector<std::string> keys;
+  for (const auto& kv : node_) keys.push_back(kv.first.as<std::string>());
+  return keys;
+}
+
 YamlReader YamlReader::Child(const std::string& key) const {
   const YAML::Node n = Get(key);
   if (!n.IsMap()) Fail(key, "expected a map of keys, found " + Show(n));

@@ -629,14 +629,23 @@ void DemSystem::ComputeForces() {
       const double pi = plastic_[i], ai = adhesion_max_[i];
       Vector3d f = f_[i];
       double max_rep = max_repulsion_[i], max_overlap = overlap_[i];
+      // the candidates come in wall order: one pass over them, a group per wall
+      auto tri_at = [&](int t) -> const WallTri& { return wall_tris_[fresh ? t : particle_tris_[t]]; };
+      int t = t_begin;
       for (int w = 0; w < W; ++w) {
         const size_t hw = static_cast<size_t>(i) * W + w;
+        if (t == t_end || tri_at(t).wall != w) {  // no triangle of this wall near
+          if (wall_touching_[hw]) {
+            wall_hist_[hw] = TangentialHistory();
+            wall_touching_[hw] = 0;
+          }
+          continue;
+        }
         const DemWall& wl = walls_[w];
         double best = 0.0;
         Vector3d q_best = Vector3d::Zero();
-        for (int t = t_begin; t < t_end; ++t) {
-          const WallTri& tr = wall_tris_[fresh ? t : particle_tris_[t]];
-          if (tr.wall != w) continue;
+        for (; t < t_end && tri_at(t).wall == w; ++t) {
+          const WallTri& tr = tri_at(t);
           // the triangle where the wall is now (it may have moved since the build)
           const auto& face = wl.mesh.faces[tr.face];
           const std::vector<Vector3d>& wv = wall_vertices_[w];

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <fstream>
 #include <memory>
-#include <random>
 
 #include <yaml-cpp/yaml.h>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/scenes/soil_prep.h"
 
 namespace dem_mobility {
 
@@ -65,12 +65,14 @@ DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* kee
   st.threads = p.threads;
   auto system = std::make_unique<DemSystem>(p.soil, st);
   DemSystem& s = *system;
-  // a loose lattice (spacing 1.2 d) over the box, as many layers as it takes, jittered: it falls
+  // a loose jittered lattice (spacing 1.2 d) over the box, as many layers as it takes: it falls
   // and settles as a poured bed
   const double a = 1.2 * D;
-  const int nx = std::max(1, static_cast<int>((L - D) / a)), ny = std::max(1, static_cast<int>((W - D) / a));
-  const int layers = (p.particles + nx * ny - 1) / (nx * ny);
-  const double H = (layers + 2) * a;
+  const std::vector<Vector3d> lattice = PourLattice(p.particles, D, 1.2, {0.0, 0.0}, {L, W},
+                                                    [](double, double) { return true; }, p.seed);
+  double z_max = 0.0;
+  for (const Vector3d& x : lattice) z_max = std::max(z_max, x.z());
+  const double H = z_max + 2 * a;
   s.AddWall(MakeQuadWall("floor", {0, 0, 0}, {L, 0, 0}, {0, W, 0}));
   s.AddWall(MakeQuadWall("x0", {0, 0, 0}, {0, 0, H}, {0, W, 0}));
   s.AddWall(MakeQuadWall("x1", {L, 0, 0}, {0, W, 0}, {0, 0, H}));
@@ -79,13 +81,7 @@ DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* kee
   DemWall lid = MakeQuadWall("lid", {0, 0, 0}, {0, W, 0}, {L, 0, 0});  // normal down
   lid.position = Vector3d(0, 0, H + a);
   const int lid_index = s.AddWall(lid);
-  std::mt19937 rng(p.seed);
-  std::uniform_real_distribution<double> jitter(-0.08 * D, 0.08 * D);
-  for (int n = 0; n < p.particles; ++n) {
-    const int i = n % nx, j = (n / nx) % ny, k = n / (nx * ny);
-    s.AddParticle(Vector3d(0.5 * L - 0.5 * (nx - 1) * a + i * a + jitter(rng),
-                           0.5 * W - 0.5 * (ny - 1) * a + j * a + jitter(rng), 0.6 * D + k * a + jitter(rng)));
-  }
+  for (const Vector3d& x : lattice) s.AddParticle(x);
   r.particles = s.size();
   r.time_step = p.time_step;
   const double mass = s.size() * s.mass(), area = L * W;
@@ -98,24 +94,18 @@ DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* kee
     run_for(p.settle_time);
     r.height_poured = LayerHeight(s);
     r.density_poured = mass / (area * r.height_poured);
-    // the lid is driven down at a speed proportional to the force it still lacks (up to
-    // lid_speed), so it settles on the target pressure. The loop gain per step is
-    // v_max dt k_layer / target (k_layer: one layer of contacts under the lid); v_max is capped so
-    // that it stays at most 0.5 and the force converges without overshoot. The hold time counts
-    // from when the particles first carry 95 % of the force.
+    // the lid settles on the target pressure (LidPress); the hold time counts from when the
+    // particles first carry 95 % of the force
     const double target = p.lid_pressure * area;
     DemWall& lw = s.mutable_wall(lid_index);
-    double z_top = 0.0;
-    s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) { z_top = std::max(z_top, x.z()); });
-    lw.position.z() = z_top + 0.6 * D;  // just clear of the highest particle
-    const double k_layer = area / (D * D) * p.soil.NormalStiffness();
-    const double v_max = std::min(p.lid_speed, 0.5 * target / (p.time_step * k_layer));
+    lw.position.z() = TopParticle(s) + 0.6 * D;  // just clear of the highest particle
+    const LidPress press(target, p.lid_speed, p.time_step, area / (D * D) * p.soil.NormalStiffness());
     double held = -1.0, pressure_sum = 0.0;
     long hold_steps = 0;
     const double t_limit = s.time() + 60.0;
     while (held < p.hold_time) {
       const double fz = s.wall(lid_index).force.z();  // the particles push the lid up
-      const double v = std::clamp(-v_max * (target - fz) / target, -v_max, v_max);
+      const double v = press.Velocity(fz);
       lw.velocity = Vector3d(0, 0, v);
       lw.position.z() += v * p.time_step;
       s.Step();
@@ -130,9 +120,7 @@ DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* kee
     r.lid_pressure_reached = pressure_sum / std::max(1L, hold_steps);
     // the lid goes back up at lid_speed until it is one diameter clear of every particle, then away
     for (;;) {
-      double top = 0.0;
-      s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) { top = std::max(top, x.z()); });
-      if (lw.position.z() > top + 0.6 * D && s.wall(lid_index).contacts == 0) break;
+      if (lw.position.z() > TopParticle(s) + 0.6 * D && s.wall(lid_index).contacts == 0) break;
       lw.velocity = Vector3d(0, 0, p.lid_speed);
       lw.position.z() += p.lid_speed * p.time_step;
       s.Step();

@@ -54,6 +54,8 @@ class YamlReader {
   Table1D Table(const std::string& key) const;
 
   YamlReader Child(const std::string& key) const;
+  /// The keys of this map, in the file's order (not marked as read).
+  std::vector<std::string> Keys() const;
 
   /// Resolves a path written in this file relative to the file's folder.
   std::string ResolvePath(const std::string& relative) const;

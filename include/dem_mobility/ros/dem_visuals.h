@@ -1,0 +1,26 @@
+// What users see of the DEM soil in rviz and in the bag: the particles as a PointCloud2 (x, y, z
+// and the plastic strain to colour them by) and the rigid walls (container, lid, cone, later the
+// tires) as triangle-list markers at their current poses.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <sensor_msgs/PointCloud2.h>
+#include <visualization_msgs/Marker.h>
+
+#include "dem_mobility/core/dem/dem_system.h"
+
+namespace dem_mobility {
+
+/// Every live particle (or those `keep` accepts, e.g. one side of a cross-section): float32
+/// fields x, y, z and plastic_strain (delta_p / d), in ID order.
+void ToPointCloud(const DemSystem& s, sensor_msgs::PointCloud2* cloud,
+                  const std::function<bool(const Eigen::Vector3d&)>& keep = nullptr);
+
+/// One wall as a TRIANGLE_LIST marker in its body frame, posed at the wall's pose.
+visualization_msgs::Marker WallMarker(const DemWall& w, const std::string& ns, int id, float r, float g, float b,
+                                      float a);
+
+}  // namespace dem_mobility

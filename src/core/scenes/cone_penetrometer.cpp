@@ -1,0 +1,448 @@
+#include "dem_mobility/core/scenes/cone_penetrometer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/dem/dem_shapes.h"
+#include "dem_mobility/core/scenes/dem_pour.h"
+#include "dem_mobility/core/scenes/soil_prep.h"
+
+namespace dem_mobility {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+namespace {
+
+constexpr double kMinCohesionFactor = 0.05, kMaxCohesionFactor = 12.0;  // the paper's range
+
+ConeLevel ReadLevel(const YamlReader& y, const std::string& name) {
+  ConeLevel l;
+  l.name = name;
+  l.particle_diameter = y.DoubleIn("particle_diameter", 0.005, 0.5);
+  l.container_diameter = y.DoubleIn("container_diameter", 0.1, 20.0);
+  l.soil_depth = y.DoubleIn("soil_depth", 0.05, 20.0);
+  l.cone_speed = y.DoubleIn("cone_speed", 1e-3, 5.0);
+  l.time_step = y.DoubleIn("time_step", 1e-8, 1e-3);
+  l.settle_time = y.DoubleIn("settle_time", 0.0, 100.0);
+  l.hold_time = y.DoubleIn("hold_time", 0.0, 100.0);
+  const std::vector<double> w = y.DoubleList("ci_window");
+  if (w.size() != 2 || !(w[0] >= 0.0 && w[1] > w[0]))
+    y.Fail("ci_window", "must be [from, to] tip depths below the surface with 0 <= from < to");
+  l.ci_from = w[0];
+  l.ci_to = w[1];
+  y.Finish();
+  return l;
+}
+
+}  // namespace
+
+ConeParams ConeParams::Read(const YamlReader& y) {
+  ConeParams p;
+  p.file = y.file();
+  const std::string scene = y.String("scene");
+  if (scene != "cone_penetrometer") y.Fail("scene", "expected 'cone_penetrometer', found '" + scene + "'");
+  p.soil = SoilParams::Read(YamlReader::Load(y.ResolvePath(y.String("soil"))));
+  // the fidelity level: every level is checked, the named one is used
+  const std::string fidelity = y.String("fidelity");
+  const YamlReader levels = y.Child("levels");
+  std::string names;
+  bool found = false;
+  for (const std::string& name : levels.Keys()) {
+    const ConeLevel l = ReadLevel(levels.Child(name), name);
+    names += (names.empty() ? "" : ", ") + name;
+    if (name == fidelity) {
+      p.level = l;
+      found = true;
+    }
+  }
+  if (!found) y.Fail("fidelity", "no level '" + fidelity + "' under levels: (" + names + ")");
+  // the soil: f directly, or from a requested cone index through a calibration table
+  const double f_file = y.Has("cohesion_factor") ? y.Double("cohesion_factor") : 1.0;
+  if (y.Has("calibration")) p.calibration_file = y.ResolvePath(y.String("calibration"));
+  if (y.Has("cone_index")) {
+    p.requested_ci = y.Positive("cone_index");
+    if (p.calibration_file.empty()) y.Fail("calibration", "is needed to turn cone_index into f");
+    try {
+      p.cohesion_factor = CiCalibration::Load(p.calibration_file).CohesionFactor(p.requested_ci);
+    } catch (const ConfigError& e) {
+      y.Fail("cone_index", e.what());
+    }
+  } else {
+    if (!y.Has("cohesion_factor")) y.Fail("cohesion_factor", "is not set (nor is cone_index)");
+    p.cohesion_factor = f_file;
+  }
+  if (!(p.cohesion_factor >= kMinCohesionFactor && p.cohesion_factor <= kMaxCohesionFactor))
+    y.Fail(y.Has("cone_index") ? "cone_index" : "cohesion_factor",
+           "the cohesion factor f = " + detail::Concat(p.cohesion_factor) + " lies outside the paper's range [" +
+               detail::Concat(kMinCohesionFactor) + ", " + detail::Concat(kMaxCohesionFactor) + "]");
+  p.friction = y.DoubleIn("friction", 0.0, 2.0);
+  p.soil.diameter = p.level.particle_diameter;
+  p.soil.cohesion_factor = p.cohesion_factor;
+  p.soil.friction = p.friction;
+  p.threads = y.Int("threads", 1);
+  if (p.threads < 1 || p.threads > 256) y.Fail("threads", "must lie in [1, 256]");
+  p.seed = static_cast<unsigned>(y.Int("seed", 1));
+  p.sample_interval = y.DoubleIn("sample_interval", 1e-4, 1.0, 0.01);
+  const YamlReader c = y.Child("container");
+  p.container_segments = c.Int("segments", 24);
+  if (p.container_segments < 8 || p.container_segments > 512) c.Fail("segments", "must lie in [8, 512]");
+  p.solid_fraction = c.DoubleIn("solid_fraction", 0.2, 0.74, 0.58);
+  c.Finish();
+  const YamlReader k = y.Child("cone");
+  p.base_diameter = k.Positive("base_diameter");
+  p.cone_length = k.Positive("length");
+  p.cone_angle_deg = k.DoubleIn("angle_deg", 1.0, 179.0);
+  p.rod_diameter = k.Positive("rod_diameter");
+  p.cone_mass = k.Positive("mass");
+  p.cone_friction = k.DoubleIn("friction", 0.0, 5.0);
+  p.start_gap = k.NonNegative("start_gap", 0.02);
+  p.cone_segments = k.Int("segments", 24);
+  if (p.cone_segments < 6 || p.cone_segments > 512) k.Fail("segments", "must lie in [6, 512]");
+  const double length = 0.5 * p.base_diameter / std::tan(0.5 * p.cone_angle_deg * M_PI / 180.0);
+  if (std::abs(length - p.cone_length) > 0.01 * p.cone_length)
+    k.Fail("length", "a " + detail::Concat(p.cone_angle_deg) + "-degree cone of base diameter " +
+                         detail::Concat(p.base_diameter) + " m is " + detail::Concat(length) + " m long, not " +
+                         detail::Concat(p.cone_length) + " m");
+  if (p.rod_diameter >= p.base_diameter) k.Fail("rod_diameter", "must be smaller than the base diameter");
+  k.Finish();
+  const YamlReader pid = y.Child("pid");
+  p.kp = pid.Positive("kp");
+  p.ki = pid.NonNegative("ki");
+  p.kd = pid.NonNegative("kd");
+  pid.Finish();
+  const YamlReader lid = y.Child("lid");
+  p.lid_pressure = lid.Positive("pressure");
+  p.lid_speed = lid.DoubleIn("speed", 1e-4, 10.0);
+  p.release_time = lid.DoubleIn("release_time", 0.0, 100.0);
+  lid.Finish();
+  y.Finish();
+  const ConeLevel& l = p.level;
+  const std::string where = "levels." + l.name;
+  if (p.base_diameter + 2.0 * l.particle_diameter > l.container_diameter)
+    y.Fail("cone.base_diameter", "the cone (" + detail::Concat(p.base_diameter) +
+                                     " m) is wider than the container of level '" + l.name + "' (" +
+                                     detail::Concat(l.container_diameter) + " m, less two particle diameters)");
+  // the surface ends up near 0.7 of the poured depth (less for a weak soil); the window must end
+  // above the floor
+  if (l.ci_to + 2.0 * l.particle_diameter > 0.7 * l.soil_depth)
+    y.Fail(where + ".ci_window", "ends at a tip depth of " + detail::Concat(l.ci_to) + " m, too deep for soil poured " +
+                                     detail::Concat(l.soil_depth) + " m deep (it settles to about " +
+                                     detail::Concat(0.7 * l.soil_depth) + " m)");
+  if (l.ci_from < p.cone_length)
+    y.Fail(where + ".ci_window", "starts at a tip depth of " + detail::Concat(l.ci_from) +
+                                     " m, before the cone's base (" + detail::Concat(p.cone_length) +
+                                     " m) is in the soil: the force is then not a steady state");
+  return p;
+}
+
+int ConeParams::ParticleCount() const {
+  const double r = 0.5 * level.container_diameter, d = level.particle_diameter;
+  return static_cast<int>(std::lround(solid_fraction * M_PI * r * r * level.soil_depth / (M_PI / 6.0 * d * d * d)));
+}
+
+double ConeParams::BaseArea() const { return M_PI * 0.25 * base_diameter * base_diameter; }
+
+const char* ConePenetrometer::PhaseName(Phase p) {
+  switch (p) {
+    case Phase::kPour: return "pour";
+    case Phase::kConsolidate: return "consolidate";
+    case Phase::kRetreat: return "retreat";
+    case Phase::kRelease: return "release";
+    case Phase::kPenetrate: return "penetrate";
+    case Phase::kDone: return "done";
+  }
+  return "?";
+}
+
+ConePenetrometer::ConePenetrometer(const ConeParams& p) : p_(p), wall0_(std::chrono::steady_clock::now()) {
+  const double d = p.level.particle_diameter, R = 0.5 * p.level.container_diameter;
+  DemSettings st;
+  st.threads = p.threads;
+  st.max_overlap = 0.25;  // a CI of 240 psi presses the particles at the cone ~9 % of d together
+  dem_ = std::make_unique<DemSystem>(p.soil, st);
+  DemSystem& s = *dem_;
+  const std::vector<Vector3d> lattice = PourLattice(
+      p.ParticleCount(), d, 1.1, {-R, -R}, {R, R},
+      [&](double x, double y) { return x * x + y * y <= (R - 0.6 * d) * (R - 0.6 * d); }, p.seed);
+  double top = 0.0;
+  for (const Vector3d& x : lattice) top = std::max(top, x.z());
+  const double wall_height = top + 2.0 * d;
+  floor_ = s.AddWall(MakeDiskWall("floor", R * 1.1, p.container_segments));
+  for (DemWall& w : MakeCylinderSideWalls("container", R, wall_height, p.container_segments)) s.AddWall(std::move(w));
+  park_z_ = wall_height + 1.0;
+  DemWall lid = MakeDiskWall("lid", R, p.container_segments);
+  lid.position = Vector3d(0, 0, top + d);
+  lid_ = s.AddWall(std::move(lid));
+  const double rod_length = p.level.ci_to + 0.5;
+  DemWall cone = MakeConeWall("cone", 0.5 * p.base_diameter, p.cone_length, p.cone_segments);
+  cone.friction = p.cone_friction;
+  z_tip_ = park_z_ + 1.0;
+  cone.position = Vector3d(0, 0, z_tip_);
+  cone.wrench_point = cone.position;
+  cone_ = s.AddWall(std::move(cone));
+  DemWall rod = MakeRodWall("rod", 0.5 * p.rod_diameter, rod_length, p.cone_segments);
+  rod.friction = p.cone_friction;
+  rod.position = Vector3d(0, 0, z_tip_ + p.cone_length);
+  rod_ = s.AddWall(std::move(rod));
+  for (const Vector3d& x : lattice) s.AddParticle(x);
+  s.Finalize(p.level.time_step);
+}
+
+ConePenetrometer::~ConePenetrometer() = default;
+
+double ConePenetrometer::penetration_force() const {
+  return dem_->wall(cone_).force.z() + dem_->wall(rod_).force.z();
+}
+
+void ConePenetrometer::NextPhase(Phase next) {
+  phase_ = next;
+  phase_start_ = dem_->time();
+}
+
+void ConePenetrometer::StepLid() {
+  DemWall& lw = dem_->mutable_wall(lid_);
+  const double dt = p_.level.time_step;
+  if (phase_ == Phase::kConsolidate) {
+    const LidPress press(lid_target_, lid_vmax_, dt, 1.0);  // lid_vmax_ is already capped
+    const double fz = dem_->wall(lid_).force.z();
+    const double v = press.Velocity(fz);
+    lw.velocity = Vector3d(0, 0, v);
+    lw.position.z() += v * dt;
+    if (held_ < 0.0 && fz >= 0.95 * lid_target_) held_ = 0.0;
+  } else {  // retreat
+    lw.velocity = Vector3d(0, 0, p_.lid_speed);
+    lw.position.z() += p_.lid_speed * dt;
+  }
+}
+
+void ConePenetrometer::PlaceCone() {
+  z_tip_ = z0_ = surface_ + p_.start_gap;
+  v_tip_ = -p_.level.cone_speed;
+  t0_ = dem_->time();
+  // the integral starts at the weight, so the cone does not sag when it is let go
+  integral_ = p_.ki > 0.0 ? p_.cone_mass * 9.81 / p_.ki : 0.0;
+  sample_z_ = z_tip_;
+  sample_t_ = t0_;
+}
+
+void ConePenetrometer::StepCone() {
+  // PID on the prescribed tip height, the soil's force from the last evaluation, semi-implicit Euler
+  const double dt = p_.level.time_step, t = dem_->time() + dt;
+  const double z_ref = z0_ - p_.level.cone_speed * (t - t0_), v_ref = -p_.level.cone_speed;
+  const double e = z_ref - z_tip_, de = v_ref - v_tip_;
+  integral_ += e * dt;
+  const double actuator = p_.kp * e + p_.ki * integral_ + p_.kd * de;
+  const double accel = (actuator + penetration_force()) / p_.cone_mass - 9.81;
+  v_tip_ += accel * dt;
+  z_tip_ += v_tip_ * dt;
+  DemWall& cone = dem_->mutable_wall(cone_);
+  cone.position = Vector3d(0, 0, z_tip_);
+  cone.velocity = Vector3d(0, 0, v_tip_);
+  cone.wrench_point = cone.position;
+  DemWall& rod = dem_->mutable_wall(rod_);
+  rod.position = Vector3d(0, 0, z_tip_ + p_.cone_length);
+  rod.velocity = cone.velocity;
+  rod.wrench_point = cone.position;
+}
+
+void ConePenetrometer::Step() {
+  if (phase_ == Phase::kDone) return;
+  DemSystem& s = *dem_;
+  const double d = p_.level.particle_diameter, R = 0.5 * p_.level.container_diameter;
+  if (phase_ == Phase::kConsolidate || phase_ == Phase::kRetreat) StepLid();
+  if (phase_ == Phase::kPenetrate) StepCone();
+  s.Step();
+  const double t = s.time() - phase_start_;
+  switch (phase_) {
+    case Phase::kPour:
+      if (t >= p_.level.settle_time - 0.5 * p_.level.time_step) {
+        height_poured_ = LayerHeight(s);
+        const double area = M_PI * R * R;
+        lid_target_ = p_.lid_pressure * area;
+        const LidPress press(lid_target_, p_.lid_speed, p_.level.time_step, area / (d * d) * p_.soil.NormalStiffness());
+        lid_vmax_ = press.max_speed();
+        s.mutable_wall(lid_).position.z() = TopParticle(s) + 0.6 * d;
+        NextPhase(Phase::kConsolidate);
+      }
+      break;
+    case Phase::kConsolidate:
+      if (held_ >= 0.0) {
+        held_ += p_.level.time_step;
+        lid_sum_ += s.wall(lid_).force.z() / (M_PI * R * R);
+        ++lid_steps_;
+        if (held_ >= p_.level.hold_time) NextPhase(Phase::kRetreat);
+      } else if (t > 30.0) {
+        throw SimulationError("cone penetrometer: the lid did not reach its pressure within 30 s");
+      }
+      break;
+    case Phase::kRetreat:
+      if (s.wall(lid_).position.z() > TopParticle(s) + 0.6 * d && s.wall(lid_).contacts == 0) {
+        DemWall& lw = s.mutable_wall(lid_);
+        lw.velocity.setZero();
+        lw.position.z() = park_z_;
+        NextPhase(Phase::kRelease);
+      } else if (t > 30.0) {
+        throw SimulationError("cone penetrometer: the lid did not come free of the particles within 30 s");
+      }
+      break;
+    case Phase::kRelease:
+      if (t >= p_.release_time - 0.5 * p_.level.time_step) {
+        surface_ = height_consolidated_ = LayerHeight(s);
+        if (surface_ - p_.level.ci_to < 2.0 * d)
+          throw SimulationError("cone penetrometer: the soil settled to " + detail::Concat(surface_) +
+                                " m, too shallow for the CI window's end at a tip depth of " +
+                                detail::Concat(p_.level.ci_to) + " m (pour more: levels." + p_.level.name +
+                                ".soil_depth)");
+        PlaceCone();
+        StepCone();  // cone walls to their start (a jump: the next step rebuilds the lists)
+        z_tip_ = z0_;
+        v_tip_ = -p_.level.cone_speed;
+        NextPhase(Phase::kPenetrate);
+      }
+      break;
+    case Phase::kPenetrate: {
+      sample_force_ += penetration_force();
+      ++sample_steps_;
+      if (s.time() - sample_t_ >= p_.sample_interval - 0.5 * p_.level.time_step) {
+        ConeSample c;
+        c.t = s.time() - t0_;
+        c.depth = tip_depth();
+        c.speed = (sample_z_ - z_tip_) / (s.time() - sample_t_);
+        c.force = sample_force_ / sample_steps_;
+        c.ci_psi = c.force / p_.BaseArea() / kPsi;
+        samples_.push_back(c);
+        sample_force_ = 0.0;
+        sample_steps_ = 0;
+        sample_z_ = z_tip_;
+        sample_t_ = s.time();
+        if (c.depth >= p_.level.ci_to) NextPhase(Phase::kDone);
+      }
+      break;
+    }
+    case Phase::kDone: break;
+  }
+}
+
+ConeResult ConePenetrometer::Run(const std::function<void(const ConePenetrometer&)>& progress, long every) {
+  try {
+    while (!done()) {
+      Step();
+      if (progress && dem_->step_count() % every == 0) progress(*this);
+    }
+  } catch (const SimulationError& e) {
+    error_ = e.what();
+  }
+  return Result();
+}
+
+ConeResult ConePenetrometer::Result() const {
+  ConeResult r;
+  const double d = p_.level.particle_diameter, R = 0.5 * p_.level.container_diameter;
+  r.level = p_.level.name;
+  r.particles = dem_->num_alive();
+  r.cohesion_factor = p_.cohesion_factor;
+  r.friction = p_.friction;
+  r.requested_ci = p_.requested_ci;
+  r.surface_height = surface_;
+  const double mass = r.particles * dem_->mass(), area = M_PI * R * R;
+  if (height_poured_ > 0.0) r.density_poured = mass / (area * height_poured_);
+  if (height_consolidated_ > 0.0) r.density_consolidated = mass / (area * height_consolidated_);
+  r.lid_pressure_reached = lid_sum_ / std::max(1L, lid_steps_);
+  r.samples = samples_;
+  // the cone index: the samples in the window, their scatter and their trend with depth
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+  r.speed_min = 1e30;
+  r.speed_max = -1e30;
+  for (const ConeSample& c : samples_) {
+    if (c.depth >= d) {
+      r.speed_min = std::min(r.speed_min, c.speed);
+      r.speed_max = std::max(r.speed_max, c.speed);
+    }
+    if (c.depth < p_.level.ci_from || c.depth > p_.level.ci_to + 1e-9) continue;
+    n += 1;
+    sx += c.depth;
+    sy += c.ci_psi;
+    sxx += c.depth * c.depth;
+    sxy += c.depth * c.ci_psi;
+    syy += c.ci_psi * c.ci_psi;
+  }
+  if (r.speed_min > r.speed_max) r.speed_min = r.speed_max = 0.0;
+  r.window_samples = static_cast<int>(n);
+  if (n > 0) {
+    r.ci_psi = sy / n;
+    r.ci_std_psi = std::sqrt(std::max(0.0, syy / n - r.ci_psi * r.ci_psi));
+    const double vx = sxx / n - (sx / n) * (sx / n);
+    if (n > 1 && vx > 0.0) r.ci_trend_psi_per_m = (sxy / n - (sx / n) * (sy / n)) / vx;
+  }
+  r.prep_time = phase_ == Phase::kPenetrate || phase_ == Phase::kDone ? t0_ : dem_->time();
+  r.sim_time = dem_->time();
+  r.time_step = p_.level.time_step;
+  r.steps = dem_->step_count();
+  r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+  r.error = error_;
+  if (r.error.empty() && phase_ != Phase::kDone) r.error = std::string("interrupted in phase ") + PhaseName(phase_);
+  return r;
+}
+
+void WriteConeResult(const ConeResult& r, const ConeParams& p, const std::string& path) {
+  YAML::Emitter e;
+  e.SetDoublePrecision(9);
+  e << YAML::BeginMap;
+  e << YAML::Key << "scene" << YAML::Value << p.file;
+  e << YAML::Key << "fidelity" << YAML::Value << r.level;
+  e << YAML::Key << "cohesion_factor" << YAML::Value << r.cohesion_factor;
+  e << YAML::Key << "friction" << YAML::Value << r.friction;
+  if (std::isfinite(r.requested_ci)) {
+    e << YAML::Key << "requested_cone_index_psi" << YAML::Value << r.requested_ci;
+    e << YAML::Key << "calibration" << YAML::Value << p.calibration_file;
+  }
+  e << YAML::Key << "cone_index_psi" << YAML::Value << r.ci_psi;
+  e << YAML::Key << "cone_index_std_psi" << YAML::Value << r.ci_std_psi;
+  e << YAML::Key << "cone_index_trend_psi_per_m" << YAML::Value << r.ci_trend_psi_per_m;
+  e << YAML::Key << "ci_window" << YAML::Value << YAML::Flow << std::vector<double>{p.level.ci_from, p.level.ci_to};
+  e << YAML::Key << "window_samples" << YAML::Value << r.window_samples;
+  e << YAML::Key << "cone_speed_min" << YAML::Value << r.speed_min;
+  e << YAML::Key << "cone_speed_max" << YAML::Value << r.speed_max;
+  e << YAML::Key << "particles" << YAML::Value << r.particles;
+  e << YAML::Key << "particle_diameter" << YAML::Value << p.level.particle_diameter;
+  e << YAML::Key << "container_diameter" << YAML::Value << p.level.container_diameter;
+  e << YAML::Key << "surface_height" << YAML::Value << r.surface_height;
+  e << YAML::Key << "bulk_density_poured" << YAML::Value << r.density_poured;
+  e << YAML::Key << "bulk_density_consolidated" << YAML::Value << r.density_consolidated;
+  e << YAML::Key << "lid_pressure_reached" << YAML::Value << r.lid_pressure_reached;
+  e << YAML::Key << "time_step" << YAML::Value << r.time_step;
+  e << YAML::Key << "steps" << YAML::Value << r.steps;
+  e << YAML::Key << "preparation_time" << YAML::Value << r.prep_time;
+  e << YAML::Key << "simulated_time" << YAML::Value << r.sim_time;
+  e << YAML::Key << "wall_time" << YAML::Value << r.wall_time;
+  e << YAML::Key << "threads" << YAML::Value << p.threads;
+  e << YAML::Key << "error" << YAML::Value << r.error;
+  // the CI history (fig. 13): one row per sample
+  std::vector<double> t, depth, speed, force, ci;
+  for (const ConeSample& c : r.samples) {
+    t.push_back(c.t);
+    depth.push_back(c.depth);
+    speed.push_back(c.speed);
+    force.push_back(c.force);
+    ci.push_back(c.ci_psi);
+  }
+  e << YAML::Key << "history" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "t" << YAML::Value << YAML::Flow << t;
+  e << YAML::Key << "tip_depth" << YAML::Value << YAML::Flow << depth;
+  e << YAML::Key << "speed" << YAML::Value << YAML::Flow << speed;
+  e << YAML::Key << "force" << YAML::Value << YAML::Flow << force;
+  e << YAML::Key << "ci_psi" << YAML::Value << YAML::Flow << ci;
+  e << YAML::EndMap;
+  e << YAML::EndMap;
+  std::ofstream out(path);
+  if (!out) throw ConfigError(path + ": cannot write the result file");
+  out << e.c_str() << "\n";
+}
+
+}  // namespace dem_mobility

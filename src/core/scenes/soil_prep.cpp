@@ -1,0 +1,50 @@
+#include "dem_mobility/core/scenes/soil_prep.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "dem_mobility/core/common/error.h"
+
+namespace dem_mobility {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+std::vector<Vector3d> PourLattice(int count, double d, double spacing, const Vector2d& lo, const Vector2d& hi,
+                                  const std::function<bool(double, double)>& inside, unsigned seed) {
+  const double a = spacing * d;
+  std::vector<Vector2d> layer;
+  for (double y = lo.y() + 0.6 * d; y <= hi.y() - 0.6 * d; y += a)
+    for (double x = lo.x() + 0.6 * d; x <= hi.x() - 0.6 * d; x += a)
+      if (inside(x, y)) layer.emplace_back(x, y);
+  DM_THROW_UNLESS(!layer.empty(), "the pour region holds no particle of diameter ", d);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-0.08 * d, 0.08 * d);
+  std::vector<Vector3d> out;
+  out.reserve(count);
+  for (int n = 0; n < count; ++n) {
+    const Vector2d& p = layer[n % layer.size()];
+    const int k = n / static_cast<int>(layer.size());
+    out.emplace_back(p.x() + jitter(rng), p.y() + jitter(rng), 0.6 * d + k * a + jitter(rng));
+  }
+  return out;
+}
+
+LidPress::LidPress(double target_force, double max_speed, double dt, double k_layer)
+    : target_(target_force), v_max_(std::min(max_speed, 0.5 * target_force / (dt * k_layer))) {
+  DM_THROW_UNLESS(target_force > 0.0 && max_speed > 0.0 && dt > 0.0 && k_layer > 0.0,
+                  "lid: target force, speed, time step and layer stiffness must be > 0");
+}
+
+double LidPress::Velocity(double fz) const {
+  return std::clamp(-v_max_ * (target_ - fz) / target_, -v_max_, v_max_);
+}
+
+double TopParticle(const DemSystem& s) {
+  double top = 0.0;
+  s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) { top = std::max(top, x.z()); });
+  return top;
+}
+
+}  // namespace dem_mobility
