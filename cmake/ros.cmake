@@ -21,7 +21,7 @@ catkin_package(
     tf2_msgs topic_tools visualization_msgs
 )
 install(DIRECTORY include/${PROJECT_NAME}/ DESTINATION ${CATKIN_PACKAGE_INCLUDE_DESTINATION})
-catkin_install_python(PROGRAMS scripts/plot_speed.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+catkin_install_python(PROGRAMS scripts/plot_speed.py scripts/plot_compression.py scripts/calibrate_cone_index.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)
   find_package(rostest REQUIRED)

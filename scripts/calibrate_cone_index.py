@@ -18,6 +18,7 @@ A failed run is reported and the others are kept; the exit status is 1 if any ru
 import argparse
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -58,7 +59,8 @@ class Run:
         for p in (self.bag, self.result_file):
             if os.path.exists(p):
                 os.remove(p)
-        env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % self.port, PYTHONUNBUFFERED='1')
+        env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % self.port, PYTHONUNBUFFERED='1',
+                   ROSCONSOLE_STDOUT_LINE_BUFFERED='1')
         cmd = ['roslaunch', '-p', str(self.port), 'dem_mobility', 'cone_penetrometer.launch',
                'scene:=' + os.path.abspath(a.scene), 'fidelity:=' + a.fidelity, 'f:=%g' % self.f,
                'mu:=%g' % self.mu, 'dem_threads:=%d' % a.dem_threads, 'bag:=' + os.path.abspath(self.bag),
@@ -80,7 +82,7 @@ class Run:
         for line in reversed(lines):
             k = line.find('progress:')
             if k >= 0:
-                return line[k + 9:].strip()
+                return re.sub(r'\x1b\[[0-9;]*m', '', line[k + 9:]).strip()
         return 'starting'
 
     def finish(self, timeout_hit=False):
@@ -203,7 +205,7 @@ def main():
     here = os.path.dirname(os.path.abspath(__file__))
     ap.add_argument('--scene', default=os.path.join(here, '..', 'config', 'scenes', 'cone_penetrometer.yaml'))
     ap.add_argument('--fidelity', default='coarse', help='level of the scene file (default coarse)')
-    ap.add_argument('--f', type=floats, default=floats('0.05,0.25,1,3,6,12'), help='cohesion factors')
+    ap.add_argument('--f', type=floats, default=floats('0.05,0.3,1.5,5,12'), help='cohesion factors')
     ap.add_argument('--mu', type=floats, default=floats('0.1,0.05'), help='inter-particle friction coefficients')
     ap.add_argument('--jobs', type=int, default=2, help='runs at a time (default 2: one per core)')
     ap.add_argument('--dem-threads', type=int, default=1, help='OpenMP threads per run (default 1)')
@@ -213,6 +215,8 @@ def main():
     ap.add_argument('--table-ci', type=floats, default=floats(','.join(str(c) for c, _ in PAPER_TABLE)),
                     help="cone indices of the table's rows (the paper's by default)")
     ap.add_argument('--install', help='also copy the mu = 0.1 table to this file (e.g. config/calibration/cone_index_mu0.1.yaml)')
+    ap.add_argument('--resume', action='store_true',
+                    help='keep the runs already in OUT that succeeded with the same level, f and mu (rerun the rest)')
     ap.add_argument('--out', default='results/calibration')
     a = ap.parse_args()
     if a.jobs < 1 or a.dem_threads < 1:
@@ -224,6 +228,19 @@ def main():
     os.makedirs(os.path.join(a.out, 'runs'), exist_ok=True)
     runs = [Run(mu, f, a.out, 0) for mu in a.mu for f in a.f]
     pending, running, done = list(runs), [], []
+    if a.resume:
+        for r in runs:
+            try:
+                with open(r.result_file) as fh:
+                    old = yaml.safe_load(fh)
+            except (OSError, yaml.YAMLError):
+                continue
+            if (old and not old.get('error') and old.get('fidelity') == a.fidelity and old.get('window_samples')
+                    and abs(old.get('cohesion_factor', -1) - r.f) < 1e-12 and abs(old.get('friction', -1) - r.mu) < 1e-12):
+                r.result, r.start, r.end = old, 0.0, float(old.get('wall_time', 0.0))
+                pending.remove(r)
+                done.append(r)
+                print('kept   %-14s CI %.1f psi (from %s)' % (r.name, r.ci(), r.result_file), flush=True)
     free_ports = [a.port + 2 * k for k in range(a.jobs)]
     t0 = time.time()
     last_status = 0.0
@@ -271,7 +288,7 @@ def main():
         doc = {
             'friction': mu,
             'fidelity': a.fidelity,
-            'scene': os.path.abspath(a.scene),
+            'scene': os.path.relpath(os.path.abspath(a.scene), os.path.dirname(here)),
             'date': time.strftime('%Y-%m-%d'),
             'method': method,
             'cubic': cubic,

@@ -3,13 +3,14 @@
 #  1. the core GoogleTest suite with plain CMake (no ROS master),
 #  2. the catkin build of the whole package, then its catkin tests: roslaunch-check on every launch
 #     file and the rostest of the lock-step exchange (test/ros/road_scene.test),
-#  3. the end-to-end road runs through roslaunch (test/ros/test_road_runs.py),
+#  3. the end-to-end road runs through roslaunch (test/ros/test_road_runs.py) and the cone index
+#     calibration sweep on tiny cases (test/ros/test_cone_sweep.py),
 #  4. catkin_lint on the package (must report nothing).
 source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
 build_core
 say "test: core suite (ctest, no ROS master)"
-(cd "$DM_BUILD/core" && ctest --output-on-failure --timeout 600)
+(cd "$DM_BUILD/core" && ctest --output-on-failure --timeout 1200 -j2)
 build_catkin
 ros_env
 say "test: catkin tests (roslaunch-check, rostest)"
@@ -21,6 +22,8 @@ if ! catkin_test_results --verbose "$DM_WS/build/test_results/dem_mobility"; the
 fi
 say "test: end-to-end road runs through roslaunch"
 DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 "$DM_ROOT/test/ros/test_road_runs.py"
+say "test: the cone index calibration sweep on tiny cases (roslaunch, bags, table, plots)"
+python3 "$DM_ROOT/test/ros/test_cone_sweep.py"
 say "test: catkin_lint"
 lint=$(cd "$DM_WS/src" && catkin_lint dem_mobility 2>&1 | grep -v rosdep)
 echo "$lint"

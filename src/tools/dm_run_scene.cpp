@@ -21,6 +21,7 @@
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
 #include "dem_mobility/core/scenes/dem_pour.h"
 #include "dem_mobility/core/scenes/road_scene.h"
+#include "dem_mobility/core/scenes/uniaxial_compression.h"
 
 using namespace dem_mobility;
 
@@ -94,6 +95,25 @@ int RunCone(const YamlReader& reader, const std::string& out_file, bool quiet) {
   return 0;
 }
 
+// The piston-cylinder compression: bulk density against pressure, loading and unloading.
+int RunCompression(const YamlReader& reader, const std::string& out_file) {
+  const CompressionParams p = CompressionParams::Read(reader);
+  std::printf("scene %s: %.3g m particles in a %.3g m cylinder, f %.3g, dt %.3g s\n", p.file.c_str(),
+              p.particle_diameter, p.cylinder_diameter, p.soil.cohesion_factor, p.time_step);
+  std::fflush(stdout);
+  const CompressionResult r = RunUniaxialCompression(p);
+  if (!out_file.empty()) WriteCompressionResult(r, p, out_file);
+  std::printf("poured: %.1f kg/m^3 (%d particles)\n", r.density_poured, r.particles);
+  for (const CompressionPoint& c : r.loading) std::printf("  loading   %8.1f kPa  %7.1f kg/m^3\n", c.pressure * 1e-3, c.density);
+  for (const CompressionPoint& c : r.unloading) std::printf("  unloading %8.1f kPa  %7.1f kg/m^3\n", c.pressure * 1e-3, c.density);
+  std::printf("released: %.1f kg/m^3; %.3f s simulated in %.1f s wall\n", r.density_released, r.sim_time, r.wall_time);
+  if (!r.error.empty()) {
+    std::cerr << "dm_run_scene: simulation error: " << r.error << "\n";
+    return 3;
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
   if (argc < 2) return Usage();
   std::string scene_file = argv[1], out_file, history_file;
@@ -123,6 +143,7 @@ int main(int argc, char** argv) {
     const std::string kind = reader.Has("scene") ? reader.String("scene") : "";
     if (kind == "dem_pour") return RunPour(reader, out_file);
     if (kind == "cone_penetrometer") return RunCone(reader, out_file, quiet);
+    if (kind == "uniaxial_compression") return RunCompression(reader, out_file);
     params = RoadSceneParams::Read(reader);
     scene = std::make_unique<RoadScene>(params);
   } catch (const ConfigError& e) {

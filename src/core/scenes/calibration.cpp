@@ -34,6 +34,9 @@ CiCalibration CiCalibration::Read(const YamlReader& y) {
   if (cubic.size() != 4) y.Fail("cubic", "must hold 4 coefficients (CI^3, CI^2, CI, 1)");
   std::copy(cubic.begin(), cubic.end(), c.cubic.begin());
   c.band = y.DoubleIn("band", 0.0, 10.0, 0.0);
+  // what the sweep wrote for people: where it came from and the runs behind it
+  for (const char* key : {"scene", "date", "method"}) y.String(key, "");
+  if (y.Has("runs")) y.Table("runs");
   y.Finish();
   return c;
 }

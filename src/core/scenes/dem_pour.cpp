@@ -19,9 +19,7 @@ using Eigen::Vector3d;
 DemPourParams DemPourParams::Read(const YamlReader& y) {
   DemPourParams p;
   p.file = y.file();
-  const std::string scene = y.String("scene");
-  if (scene != "dem_pour") y.Fail("scene", "expected 'dem_pour', found '" + scene + "'");
-  p.soil = SoilParams::Read(YamlReader::Load(y.ResolvePath(y.String("soil"))));
+  p.soil = ReadSceneSoil(y, "dem_pour");
   const YamlReader box = y.Child("box");
   p.box_length = box.Positive("length");
   p.box_width = box.Positive("width");

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
 
 namespace dem_mobility {
 
@@ -39,6 +40,12 @@ LidPress::LidPress(double target_force, double max_speed, double dt, double k_la
 
 double LidPress::Velocity(double fz) const {
   return std::clamp(-v_max_ * (target_ - fz) / target_, -v_max_, v_max_);
+}
+
+SoilParams ReadSceneSoil(const YamlReader& y, const std::string& kind) {
+  const std::string scene = y.String("scene");
+  if (scene != kind) y.Fail("scene", "expected '" + kind + "', found '" + scene + "'");
+  return SoilParams::Read(YamlReader::Load(y.ResolvePath(y.String("soil"))));
 }
 
 double TopParticle(const DemSystem& s) {

@@ -4,11 +4,14 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "dem_mobility/core/dem/dem_system.h"
 
 namespace dem_mobility {
+
+class YamlReader;
 
 /// Positions of `count` particles of diameter d on a jittered square lattice (spacing `spacing`
 /// d) over the floor z = 0, layer after layer, inside the region where `inside(x, y)` holds
@@ -32,6 +35,10 @@ class LidPress {
  private:
   double target_, v_max_;
 };
+
+/// Checks that `y` is a scene file of `kind` (its `scene:` key) and reads its soil file (`soil:`,
+/// relative to the scene file). ConfigError names the file and key.
+SoilParams ReadSceneSoil(const YamlReader& y, const std::string& kind);
 
 /// Height of the highest particle centre (0 without particles).
 double TopParticle(const DemSystem& s);

@@ -1,0 +1,49 @@
+#!/usr/bin/env python3
+"""Bulk density versus pressure of a piston-cylinder compression run (paper fig. 9): loading,
+unloading and the density once the piston is gone, from dm_run_scene's result YAML.
+
+    python3 scripts/plot_compression.py RESULT.yaml [-o compression.png]
+"""
+import argparse
+import os
+import sys
+
+import matplotlib
+matplotlib.use('Agg')
+import matplotlib.pyplot as plt  # noqa: E402
+import yaml  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument('result')
+    ap.add_argument('-o', '--out', help='PNG file (default: the result with .png)')
+    a = ap.parse_args()
+    try:
+        with open(a.result) as fh:
+            r = yaml.safe_load(fh)
+        load, unload = r['loading'], r['unloading']
+    except (OSError, yaml.YAMLError, KeyError, TypeError) as e:
+        sys.exit('plot_compression: cannot read %s: %s' % (a.result, e))
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ax.plot([p[0] * 1e-3 for p in load], [p[1] for p in load], 'o-', label='loading')
+    if unload:
+        ax.plot([load[-1][0] * 1e-3] + [p[0] * 1e-3 for p in unload], [load[-1][1]] + [p[1] for p in unload], 's--',
+                label='unloading')
+    ax.axhline(r['bulk_density_poured'], color='gray', lw=0.8, ls=':', label='poured')
+    if r.get('bulk_density_released'):
+        ax.axhline(r['bulk_density_released'], color='k', lw=0.8, ls='-.', label='piston removed')
+    ax.set_xscale('log')
+    ax.set_xlabel('normal pressure [kPa]')
+    ax.set_ylabel('bulk density [kg/m^3]')
+    ax.set_title('Uniaxial compression, f = %g (paper fig. 9)' % r.get('cohesion_factor', float('nan')))
+    ax.grid(alpha=0.3, which='both')
+    ax.legend()
+    out = a.out or os.path.splitext(a.result)[0] + '.png'
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    print('plot: %s' % out)
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,152 @@
+#include "dem_mobility/core/scenes/uniaxial_compression.h"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/dem/dem_shapes.h"
+#include "dem_mobility/core/scenes/dem_pour.h"
+#include "dem_mobility/core/scenes/soil_prep.h"
+
+namespace dem_mobility {
+
+using Eigen::Vector3d;
+
+CompressionParams CompressionParams::Read(const YamlReader& y) {
+  CompressionParams p;
+  p.file = y.file();
+  p.soil = ReadSceneSoil(y, "uniaxial_compression");
+  p.particle_diameter = y.DoubleIn("particle_diameter", 0.005, 0.5);
+  p.soil.diameter = p.particle_diameter;
+  if (y.Has("cohesion_factor")) p.soil.cohesion_factor = y.DoubleIn("cohesion_factor", 0.05, 12.0);
+  if (y.Has("friction")) p.soil.friction = y.DoubleIn("friction", 0.0, 2.0);
+  p.cylinder_diameter = y.DoubleIn("cylinder_diameter", 0.05, 10.0);
+  if (p.cylinder_diameter < 5.0 * p.particle_diameter) y.Fail("cylinder_diameter", "must hold at least 5 particle diameters");
+  p.soil_depth = y.DoubleIn("soil_depth", 0.02, 10.0);
+  p.time_step = y.DoubleIn("time_step", 1e-8, 1e-3);
+  p.settle_time = y.DoubleIn("settle_time", 0.0, 100.0);
+  p.hold_time = y.DoubleIn("hold_time", 0.0, 100.0);
+  p.piston_speed = y.DoubleIn("piston_speed", 1e-4, 10.0);
+  p.loading = y.DoubleList("loading");
+  p.unloading = y.DoubleList("unloading");
+  if (p.loading.empty()) y.Fail("loading", "needs at least one pressure");
+  for (size_t k = 0; k < p.loading.size(); ++k)
+    if (!(p.loading[k] > 0.0) || (k > 0 && !(p.loading[k] > p.loading[k - 1])))
+      y.Fail("loading", "pressures must be > 0 and increasing");
+  for (size_t k = 0; k < p.unloading.size(); ++k)
+    if (!(p.unloading[k] > 0.0) || !(p.unloading[k] < (k > 0 ? p.unloading[k - 1] : p.loading.back())))
+      y.Fail("unloading", "pressures must be > 0, decreasing, and below the last loading pressure");
+  p.solid_fraction = y.DoubleIn("solid_fraction", 0.2, 0.74, 0.58);
+  p.threads = y.Int("threads", 1);
+  if (p.threads < 1 || p.threads > 256) y.Fail("threads", "must lie in [1, 256]");
+  p.seed = static_cast<unsigned>(y.Int("seed", 1));
+  y.Finish();
+  return p;
+}
+
+CompressionResult RunUniaxialCompression(const CompressionParams& p) {
+  CompressionResult r;
+  const auto wall0 = std::chrono::steady_clock::now();
+  const double d = p.particle_diameter, R = 0.5 * p.cylinder_diameter, area = M_PI * R * R;
+  DemSettings st;
+  st.threads = p.threads;
+  DemSystem s(p.soil, st);
+  const int count = static_cast<int>(std::lround(p.solid_fraction * area * p.soil_depth / (M_PI / 6.0 * d * d * d)));
+  const std::vector<Vector3d> lattice = PourLattice(
+      count, d, 1.1, {-R, -R}, {R, R}, [&](double x, double y) { return x * x + y * y <= (R - 0.6 * d) * (R - 0.6 * d); },
+      p.seed);
+  double top = 0.0;
+  for (const Vector3d& x : lattice) top = std::max(top, x.z());
+  s.AddWall(MakeDiskWall("floor", 1.1 * R, 24));
+  for (DemWall& w : MakeCylinderSideWalls("cylinder", R, top + 2.0 * d, 24)) s.AddWall(std::move(w));
+  DemWall piston = MakeDiskWall("piston", R, 24);
+  piston.position = Vector3d(0, 0, top + d);
+  const int pw = s.AddWall(std::move(piston));
+  for (const Vector3d& x : lattice) s.AddParticle(x);
+  r.particles = s.num_alive();
+  const double mass = r.particles * s.mass(), k_layer = area / (d * d) * p.soil.NormalStiffness();
+  try {
+    s.Finalize(p.time_step);
+    for (long n = std::lround(p.settle_time / p.time_step); n > 0; --n) s.Step();
+    r.density_poured = mass / (area * LayerHeight(s));
+    DemWall& w = s.mutable_wall(pw);
+    w.position.z() = TopParticle(s) + 0.6 * d;
+    // each pressure: the piston settles on it (LidPress), holds it, and the density is read from
+    // the piston's height (as in the apparatus)
+    auto hold = [&](double pressure) {
+      const LidPress press(pressure * area, p.piston_speed, p.time_step, k_layer);
+      double held = -1.0, sum_p = 0.0, sum_h = 0.0;
+      long n = 0;
+      const double limit = s.time() + 30.0;
+      while (held < p.hold_time) {
+        const double fz = s.wall(pw).force.z();
+        const double v = press.Velocity(fz);
+        w.velocity = Vector3d(0, 0, v);
+        w.position.z() += v * p.time_step;
+        s.Step();
+        if (held < 0.0 && std::abs(fz - press.target()) <= 0.05 * press.target()) held = 0.0;
+        if (held >= 0.0) {
+          held += p.time_step;
+          sum_p += s.wall(pw).force.z() / area;
+          sum_h += w.position.z();
+          ++n;
+        }
+        if (s.time() > limit)
+          throw SimulationError("uniaxial compression: the piston did not settle on " + detail::Concat(pressure) +
+                                " Pa within 30 s");
+      }
+      CompressionPoint c;
+      c.pressure = sum_p / std::max(1L, n);
+      c.density = mass / (area * sum_h / std::max(1L, n));
+      return c;
+    };
+    for (double pr : p.loading) r.loading.push_back(hold(pr));
+    for (double pr : p.unloading) r.unloading.push_back(hold(pr));
+    // the piston leaves; the soil's free surface after it
+    w.velocity = Vector3d(0, 0, p.piston_speed);
+    while (s.wall(pw).contacts > 0 || w.position.z() < TopParticle(s) + 0.6 * d) {
+      w.position.z() += p.piston_speed * p.time_step;
+      s.Step();
+    }
+    w.velocity.setZero();
+    for (long n = std::lround(0.1 / p.time_step); n > 0; --n) s.Step();
+    r.density_released = mass / (area * LayerHeight(s));
+  } catch (const SimulationError& e) {
+    r.error = e.what();
+  }
+  r.sim_time = s.time();
+  r.steps = s.step_count();
+  r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return r;
+}
+
+void WriteCompressionResult(const CompressionResult& r, const CompressionParams& p, const std::string& path) {
+  YAML::Emitter e;
+  e << YAML::BeginMap;
+  e << YAML::Key << "scene" << YAML::Value << p.file;
+  e << YAML::Key << "particles" << YAML::Value << r.particles;
+  e << YAML::Key << "cohesion_factor" << YAML::Value << p.soil.cohesion_factor;
+  e << YAML::Key << "bulk_density_poured" << YAML::Value << r.density_poured;
+  auto points = [&](const char* key, const std::vector<CompressionPoint>& v) {
+    e << YAML::Key << key << YAML::Value << YAML::BeginSeq;
+    for (const CompressionPoint& c : v) e << YAML::Flow << std::vector<double>{c.pressure, c.density};
+    e << YAML::EndSeq;
+  };
+  points("loading", r.loading);      // [pressure Pa, bulk density kg/m^3]
+  points("unloading", r.unloading);
+  e << YAML::Key << "bulk_density_released" << YAML::Value << r.density_released;
+  e << YAML::Key << "simulated_time" << YAML::Value << r.sim_time;
+  e << YAML::Key << "steps" << YAML::Value << r.steps;
+  e << YAML::Key << "wall_time" << YAML::Value << r.wall_time;
+  e << YAML::Key << "error" << YAML::Value << r.error;
+  e << YAML::EndMap;
+  std::ofstream out(path);
+  if (!out) throw ConfigError(path + ": cannot write the result file");
+  out << e.c_str() << "\n";
+}
+
+}  // namespace dem_mobility

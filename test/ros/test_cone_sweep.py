@@ -1,0 +1,86 @@
+#!/usr/bin/env python3
+"""The calibration sweep command on two tiny cone penetrometer cases (plus one it must refuse):
+it runs them through roslaunch in parallel, keeps the good runs when one fails, and writes the
+table, the fit and the plots; each run's bag holds the particles, the CI history and the result.
+
+    python3 test/ros/test_cone_sweep.py      (in a sourced catkin workspace)
+"""
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import rosbag
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+class ConeSweep(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.out = tempfile.mkdtemp(prefix='dm_cone_sweep_')
+        cls.proc = subprocess.run(
+            [sys.executable, os.path.join(ROOT, 'scripts', 'calibrate_cone_index.py'), '--fidelity', 'tiny',
+             '--f', '0.5,8,20', '--mu', '0.1', '--jobs', '2', '--cloud-rate', '10', '--port', '11711',
+             '--out', cls.out], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
+            timeout=900)
+        print(cls.proc.stdout)
+
+    def test_failed_run_reported_rest_kept(self):
+        self.assertEqual(self.proc.returncode, 1)  # one run failed
+        self.assertIn('FAILED', self.proc.stdout)
+        with open(os.path.join(self.out, 'sweep.yaml')) as fh:
+            sweep = yaml.safe_load(fh)
+        runs = {r['f']: r for r in sweep['runs']}
+        self.assertFalse(runs[20.0]['ok'])
+        self.assertIn('cohesion_factor', runs[20.0]['error'])
+        self.assertTrue(runs[0.5]['ok'] and runs[8.0]['ok'])
+        self.assertGreater(runs[8.0]['cone_index_psi'], runs[0.5]['cone_index_psi'])
+
+    def test_table_and_fit(self):
+        with open(os.path.join(self.out, 'cone_index_mu0.1.yaml')) as fh:
+            cal = yaml.safe_load(fh)
+        self.assertEqual(cal['fidelity'], 'tiny')
+        self.assertEqual(len(cal['cubic']), 4)
+        rows = cal['table']
+        self.assertGreaterEqual(len(rows), 2)
+        for a, b in zip(rows, rows[1:]):
+            self.assertLess(a[0], b[0])
+            self.assertLess(a[1], b[1])
+        # the table passes through the two runs (a line through two points)
+        for f, ci in cal['runs']:
+            self.assertTrue(any(abs(r[0] - round(ci, 1)) < 0.06 and abs(r[1] - f) < 0.01 * f for r in rows),
+                            (f, ci, rows))
+
+    def test_plots(self):
+        for name in ('ci_vs_time_mu0.1.png', 'ci_vs_f.png'):
+            with open(os.path.join(self.out, name), 'rb') as fh:
+                self.assertEqual(fh.read(8), b'\x89PNG\r\n\x1a\n', name)
+
+    def test_bag_holds_particles_ci_history_and_result(self):
+        bag_path = os.path.join(self.out, 'runs', 'mu0.1_f0.5.bag')
+        with open(bag_path[:-4] + '.result.yaml') as fh:
+            res = yaml.safe_load(fh)
+        counts, result, clouds = {}, None, 0
+        with rosbag.Bag(bag_path) as bag:
+            for topic, msg, _ in bag.read_messages():
+                counts[topic] = counts.get(topic, 0) + 1
+                if topic == '/cone/result':
+                    result = msg
+                if topic == '/cone/terrain/particles':
+                    clouds += 1
+                    self.assertEqual([f.name for f in msg.fields], ['x', 'y', 'z', 'plastic_strain'])
+                    self.assertEqual(msg.width, res['particles'])
+        self.assertEqual(counts.get('/cone/cone/penetration'), len(res['history']['t']))
+        self.assertGreater(clouds, 10)
+        self.assertGreater(counts.get('/cone/terrain/tools', 0), 10)
+        self.assertEqual(counts.get('/cone/terrain/markers'), 1)
+        self.assertIsNotNone(result)
+        self.assertEqual(result.status, 'ok')
+        self.assertAlmostEqual(result.cone_index_psi, res['cone_index_psi'], places=6)
+
+
+if __name__ == '__main__':
+    unittest.main()
