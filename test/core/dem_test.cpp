@@ -128,13 +128,13 @@ TEST(Dem, ExcessiveOverlapStopsTheRun) {
   DemSystem s(Nominal(), DemSettings());
   s.set_gravity(Vector3d::Zero());
   s.AddParticle(Vector3d::Zero());
-  s.AddParticle(Vector3d(0.75 * 0.03, 0, 0));  // 25 % of the diameter: beyond the 10 % limit
+  s.AddParticle(Vector3d(0.65 * 0.03, 0, 0));  // 35 % of the diameter: beyond the 25 % limit
   s.Finalize(1e-5);
   try {
     s.Step();
-    FAIL() << "a 25 % overlap went through";
+    FAIL() << "a 35 % overlap went through";
   } catch (const SimulationError& e) {
-    EXPECT_NE(std::string(e.what()).find("overlaps a neighbour by 0.24"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("overlaps a neighbour by 0.34"), std::string::npos) << e.what();
   }
 }
 
@@ -210,12 +210,14 @@ DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* c
 TEST(Dem, PouredBedSettles) {
   double vmax, overlap, carried;
   PourIntoABox(false, &vmax, &overlap, &carried);
+  // pairs rest at the adhesion's reach d0 (fig. 7), plus a little under the weight above
+  const double rest = Nominal().adhesion_depth + 0.01;
   EXPECT_LT(vmax, 1e-3);
-  EXPECT_LT(overlap, 0.02);
+  EXPECT_LT(overlap, rest);
   EXPECT_NEAR(carried, 1.0, 0.01);
   PourIntoABox(true, &vmax, &overlap, &carried);
   EXPECT_LT(vmax, Nominal().relax_speed);
-  EXPECT_LT(overlap, 0.02);
+  EXPECT_LT(overlap, rest + 2 * 0.004);  // + twice fig. 8's plastic strain at the weight's stress
   EXPECT_NEAR(carried, 1.0, 0.01);
 }
 
