@@ -17,6 +17,7 @@
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/MarkerArray.h>
+#include <yaml-cpp/yaml.h>
 
 #include "dem_mobility/ConeIndexResult.h"
 #include "dem_mobility/ConePenetration.h"
@@ -168,7 +169,12 @@ class TerrainNodelet : public nodelet::Nodelet {
       m.status = "error";
       m.error = e.what();
       result_.publish(m);
-      if (!result_file_.empty()) std::ofstream(result_file_) << "status: error\nerror: \"" << Escape(e.what()) << "\"\n";
+      if (!result_file_.empty()) {
+        YAML::Emitter y;
+        y << YAML::BeginMap << YAML::Key << "status" << YAML::Value << "error" << YAML::Key << "error" << YAML::Value
+          << e.what() << YAML::EndMap;
+        std::ofstream(result_file_) << y.c_str() << "\n";
+      }
       ros::requestShutdown();
       return;
     }
@@ -176,12 +182,6 @@ class TerrainNodelet : public nodelet::Nodelet {
                  cone_params_.level.name.c_str(), cone_params_.cohesion_factor, cone_params_.friction,
                  rig_->dem().num_alive());
     rig_thread_ = std::thread([this] { RunRig(); });
-  }
-
-  static std::string Escape(const std::string& s) {
-    std::string o;
-    for (char c : s) o += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
-    return o;
   }
 
   void RunRig() {
@@ -319,8 +319,7 @@ class TerrainNodelet : public nodelet::Nodelet {
     text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
     text.action = visualization_msgs::Marker::ADD;
     text.pose.orientation.w = 1.0;
-    text.pose.position.z = s.wall(rig_->floor_wall()).position.z() + 0.5 * cone_params_.level.container_diameter +
-                           cone_params_.level.soil_depth + 0.3;
+    text.pose.position.z = cone_params_.level.soil_depth + 0.3;  // above the poured soil
     text.scale.z = 0.12;
     text.color.r = text.color.g = text.color.b = text.color.a = 1.0f;
     char buf[160];

@@ -145,7 +145,9 @@ TEST(UniaxialCompression, DensityRisesWithPressureAndMostCompactionRemains) {
   for (size_t k = 0; k < r.loading.size(); ++k) {
     // the piston is a proportional controller: while the soil creeps it lags by up to ~15 %
     EXPECT_NEAR(r.loading[k].pressure, p.loading[k], 0.2 * p.loading[k]);
-    if (k > 0) EXPECT_GT(r.loading[k].pressure, r.loading[k - 1].pressure);
+    if (k > 0) {
+      EXPECT_GT(r.loading[k].pressure, r.loading[k - 1].pressure);
+    }
     EXPECT_GT(r.loading[k].density, prev) << "at " << r.loading[k].pressure << " Pa";
     prev = r.loading[k].density;
   }

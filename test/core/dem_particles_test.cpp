@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_test_soils.h"
 
@@ -95,11 +96,7 @@ DemSystem Stream(int threads, long* adds) {
   DemSettings st;
   st.threads = threads;
   DemSystem s(p, st);
-  s.AddWall(MakeQuadWall("floor", {0, 0, 0}, {L, 0, 0}, {0, L, 0}));
-  s.AddWall(MakeQuadWall("x0", {0, 0, 0}, {0, 0, L}, {0, L, 0}));
-  s.AddWall(MakeQuadWall("x1", {L, 0, 0}, {0, L, 0}, {0, 0, L}));
-  s.AddWall(MakeQuadWall("y0", {0, 0, 0}, {L, 0, 0}, {0, 0, L}));
-  s.AddWall(MakeQuadWall("y1", {0, L, 0}, {0, 0, L}, {L, 0, 0}));
+  for (DemWall& w : MakeOpenBoxWalls(L, L, L)) s.AddWall(std::move(w));
   // 25 emission points, each used every 1000 steps, high above the columns that pile up below them
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> jitter(-0.1 * D, 0.1 * D);

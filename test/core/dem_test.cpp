@@ -6,6 +6,7 @@
 #include <random>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_test_soils.h"
 
@@ -178,11 +179,7 @@ DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* c
   DemSettings st;
   st.threads = 2;
   DemSystem s(p, st);
-  s.AddWall(MakeQuadWall("floor", {0, 0, 0}, {L, 0, 0}, {0, L, 0}));
-  s.AddWall(MakeQuadWall("x0", {0, 0, 0}, {0, 0, L}, {0, L, 0}));
-  s.AddWall(MakeQuadWall("x1", {L, 0, 0}, {0, L, 0}, {0, 0, L}));
-  s.AddWall(MakeQuadWall("y0", {0, 0, 0}, {L, 0, 0}, {0, 0, L}));
-  s.AddWall(MakeQuadWall("y1", {0, L, 0}, {0, 0, L}, {L, 0, 0}));
+  for (DemWall& w : MakeOpenBoxWalls(L, L, L)) s.AddWall(std::move(w));
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-0.02 * D, 0.02 * D);
   for (int k = 0; k < 4; ++k)

@@ -45,6 +45,14 @@ void AddBand(TriMesh* m, int lower, int upper, int segments) {
 
 }  // namespace
 
+std::vector<DemWall> MakeOpenBoxWalls(double L, double W, double H) {
+  CheckShape("box", L, W, 3);
+  CheckShape("box", H, H, 3);
+  return {MakeQuadWall("floor", {0, 0, 0}, {L, 0, 0}, {0, W, 0}), MakeQuadWall("x0", {0, 0, 0}, {0, 0, H}, {0, W, 0}),
+          MakeQuadWall("x1", {L, 0, 0}, {0, W, 0}, {0, 0, H}), MakeQuadWall("y0", {0, 0, 0}, {L, 0, 0}, {0, 0, H}),
+          MakeQuadWall("y1", {0, W, 0}, {0, 0, H}, {L, 0, 0})};
+}
+
 DemWall MakeDiskWall(const std::string& name, double radius, int segments) {
   CheckShape(name, radius, radius, segments);
   DemWall w;

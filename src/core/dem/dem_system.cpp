@@ -64,6 +64,9 @@ int DemSystem::AddWall(DemWall wall) {
   wp.friction = wall.friction;
   wall_law_.emplace_back(wp);
   walls_.push_back(std::move(wall));
+  // one contact history per particle and wall (nothing has touched yet: walls come before Finalize)
+  wall_hist_.assign(x_.size() * walls_.size(), TangentialHistory());
+  wall_touching_.assign(x_.size() * walls_.size(), 0);
   rebuild_ = true;
   return static_cast<int>(walls_.size()) - 1;
 }

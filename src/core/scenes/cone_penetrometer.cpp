@@ -83,8 +83,7 @@ ConeParams ConeParams::Read(const YamlReader& y) {
   p.soil.diameter = p.level.particle_diameter;
   p.soil.cohesion_factor = p.cohesion_factor;
   p.soil.friction = p.friction;
-  p.threads = y.Int("threads", 1);
-  if (p.threads < 1 || p.threads > 256) y.Fail("threads", "must lie in [1, 256]");
+  p.threads = ReadThreads(y);
   p.seed = static_cast<unsigned>(y.Int("seed", 1));
   p.sample_interval = y.DoubleIn("sample_interval", 1e-4, 1.0, 0.01);
   const YamlReader c = y.Child("container");
@@ -159,7 +158,7 @@ const char* ConePenetrometer::PhaseName(Phase p) {
 }
 
 ConePenetrometer::ConePenetrometer(const ConeParams& p) : p_(p), wall0_(std::chrono::steady_clock::now()) {
-  const double d = p.level.particle_diameter, R = 0.5 * p.level.container_diameter;
+  const double R = 0.5 * p.level.container_diameter;
   DemSettings st;
   st.threads = p.threads;
   // near a cone at CI 240 psi (1.7 MPa) a pair overlaps by d0 (5 %), twice the plastic deformation
@@ -167,18 +166,10 @@ ConePenetrometer::ConePenetrometer(const ConeParams& p) : p_(p), wall0_(std::chr
   st.max_overlap = 0.4;
   dem_ = std::make_unique<DemSystem>(p.soil, st);
   DemSystem& s = *dem_;
-  const std::vector<Vector3d> lattice = PourLattice(
-      p.ParticleCount(), d, 1.1, {-R, -R}, {R, R},
-      [&](double x, double y) { return x * x + y * y <= (R - 0.6 * d) * (R - 0.6 * d); }, p.seed);
-  double top = 0.0;
-  for (const Vector3d& x : lattice) top = std::max(top, x.z());
-  const double wall_height = top + 2.0 * d;
-  floor_ = s.AddWall(MakeDiskWall("floor", R * 1.1, p.container_segments));
-  for (DemWall& w : MakeCylinderSideWalls("container", R, wall_height, p.container_segments)) s.AddWall(std::move(w));
-  park_z_ = wall_height + 1.0;
-  DemWall lid = MakeDiskWall("lid", R, p.container_segments);
-  lid.position = Vector3d(0, 0, top + d);
-  lid_ = s.AddWall(std::move(lid));
+  const CylinderBed bed = AddCylinderBed(&s, R, p.ParticleCount(), p.container_segments, p.seed);
+  floor_ = bed.floor;
+  lid_ = bed.lid;
+  park_z_ = bed.wall_height + 1.0;
   const double rod_length = p.level.ci_to + 0.5;
   DemWall cone = MakeConeWall("cone", 0.5 * p.base_diameter, p.cone_length, p.cone_segments);
   cone.friction = p.cone_friction;
@@ -190,7 +181,6 @@ ConePenetrometer::ConePenetrometer(const ConeParams& p) : p_(p), wall0_(std::chr
   rod.friction = p.cone_friction;
   rod.position = Vector3d(0, 0, z_tip_ + p.cone_length);
   rod_ = s.AddWall(std::move(rod));
-  for (const Vector3d& x : lattice) s.AddParticle(x);
   s.Finalize(p.level.time_step);
 }
 
@@ -209,12 +199,11 @@ void ConePenetrometer::StepLid() {
   DemWall& lw = dem_->mutable_wall(lid_);
   const double dt = p_.level.time_step;
   if (phase_ == Phase::kConsolidate) {
-    const LidPress press(lid_target_, lid_vmax_, dt, 1.0);  // lid_vmax_ is already capped
     const double fz = dem_->wall(lid_).force.z();
-    const double v = press.Velocity(fz);
+    const double v = press_->Velocity(fz);
     lw.velocity = Vector3d(0, 0, v);
     lw.position.z() += v * dt;
-    if (held_ < 0.0 && fz >= 0.95 * lid_target_) held_ = 0.0;
+    if (held_ < 0.0 && fz >= 0.95 * press_->target()) held_ = 0.0;
   } else {  // retreat
     lw.velocity = Vector3d(0, 0, p_.lid_speed);
     lw.position.z() += p_.lid_speed * dt;
@@ -264,9 +253,8 @@ void ConePenetrometer::Step() {
       if (t >= p_.level.settle_time - 0.5 * p_.level.time_step) {
         height_poured_ = LayerHeight(s);
         const double area = M_PI * R * R;
-        lid_target_ = p_.lid_pressure * area;
-        const LidPress press(lid_target_, p_.lid_speed, p_.level.time_step, area / (d * d) * p_.soil.NormalStiffness());
-        lid_vmax_ = press.max_speed();
+        press_ = std::make_unique<LidPress>(p_.lid_pressure * area, p_.lid_speed, p_.level.time_step,
+                                            area / (d * d) * p_.soil.NormalStiffness());
         s.mutable_wall(lid_).position.z() = TopParticle(s) + 0.6 * d;
         NextPhase(Phase::kConsolidate);
       }

@@ -10,6 +10,7 @@
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/scenes/soil_prep.h"
 
 namespace dem_mobility {
@@ -27,8 +28,7 @@ DemPourParams DemPourParams::Read(const YamlReader& y) {
   p.particles = y.Int("particles");
   if (p.particles < 1 || p.particles > 5000000) y.Fail("particles", "must lie in [1, 5e6]");
   p.time_step = y.DoubleIn("time_step", 1e-8, 1e-3);
-  p.threads = y.Int("threads", 1);
-  if (p.threads < 1 || p.threads > 256) y.Fail("threads", "must lie in [1, 256]");
+  p.threads = ReadThreads(y);
   p.settle_time = y.DoubleIn("settle_time", 0.0, 100.0);
   const YamlReader lid = y.Child("lid");
   p.lid_pressure = lid.Positive("pressure");
@@ -71,11 +71,7 @@ DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* kee
   double z_max = 0.0;
   for (const Vector3d& x : lattice) z_max = std::max(z_max, x.z());
   const double H = z_max + 2 * a;
-  s.AddWall(MakeQuadWall("floor", {0, 0, 0}, {L, 0, 0}, {0, W, 0}));
-  s.AddWall(MakeQuadWall("x0", {0, 0, 0}, {0, 0, H}, {0, W, 0}));
-  s.AddWall(MakeQuadWall("x1", {L, 0, 0}, {0, W, 0}, {0, 0, H}));
-  s.AddWall(MakeQuadWall("y0", {0, 0, 0}, {L, 0, 0}, {0, 0, H}));
-  s.AddWall(MakeQuadWall("y1", {0, W, 0}, {0, 0, H}, {L, 0, 0}));
+  for (DemWall& w : MakeOpenBoxWalls(L, W, H)) s.AddWall(std::move(w));
   DemWall lid = MakeQuadWall("lid", {0, 0, 0}, {0, W, 0}, {L, 0, 0});  // normal down
   lid.position = Vector3d(0, 0, H + a);
   const int lid_index = s.AddWall(lid);

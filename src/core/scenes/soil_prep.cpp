@@ -6,6 +6,7 @@
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/dem/dem_shapes.h"
 
 namespace dem_mobility {
 
@@ -40,6 +41,30 @@ LidPress::LidPress(double target_force, double max_speed, double dt, double k_la
 
 double LidPress::Velocity(double fz) const {
   return std::clamp(-v_max_ * (target_ - fz) / target_, -v_max_, v_max_);
+}
+
+CylinderBed AddCylinderBed(DemSystem* s, double R, int count, int segments, unsigned seed) {
+  const double d = s->soil().diameter;
+  const std::vector<Vector3d> lattice = PourLattice(
+      count, d, 1.1, {-R, -R}, {R, R}, [&](double x, double y) { return x * x + y * y <= (R - 0.6 * d) * (R - 0.6 * d); },
+      seed);
+  double top = 0.0;
+  for (const Vector3d& x : lattice) top = std::max(top, x.z());
+  CylinderBed bed;
+  bed.wall_height = top + 2.0 * d;
+  bed.floor = s->AddWall(MakeDiskWall("floor", 1.1 * R, segments));
+  for (DemWall& w : MakeCylinderSideWalls("container", R, bed.wall_height, segments)) s->AddWall(std::move(w));
+  DemWall lid = MakeDiskWall("lid", R, segments);
+  lid.position = Vector3d(0, 0, top + d);
+  bed.lid = s->AddWall(std::move(lid));
+  for (const Vector3d& x : lattice) s->AddParticle(x);
+  return bed;
+}
+
+int ReadThreads(const YamlReader& y) {
+  const int threads = y.Int("threads", 1);
+  if (threads < 1 || threads > 256) y.Fail("threads", "must lie in [1, 256]");
+  return threads;
 }
 
 SoilParams ReadSceneSoil(const YamlReader& y, const std::string& kind) {

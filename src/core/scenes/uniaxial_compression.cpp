@@ -8,7 +8,6 @@
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/scenes/dem_pour.h"
 #include "dem_mobility/core/scenes/soil_prep.h"
 
@@ -41,8 +40,7 @@ CompressionParams CompressionParams::Read(const YamlReader& y) {
     if (!(p.unloading[k] > 0.0) || !(p.unloading[k] < (k > 0 ? p.unloading[k - 1] : p.loading.back())))
       y.Fail("unloading", "pressures must be > 0, decreasing, and below the last loading pressure");
   p.solid_fraction = y.DoubleIn("solid_fraction", 0.2, 0.74, 0.58);
-  p.threads = y.Int("threads", 1);
-  if (p.threads < 1 || p.threads > 256) y.Fail("threads", "must lie in [1, 256]");
+  p.threads = ReadThreads(y);
   p.seed = static_cast<unsigned>(y.Int("seed", 1));
   y.Finish();
   return p;
@@ -56,17 +54,7 @@ CompressionResult RunUniaxialCompression(const CompressionParams& p) {
   st.threads = p.threads;
   DemSystem s(p.soil, st);
   const int count = static_cast<int>(std::lround(p.solid_fraction * area * p.soil_depth / (M_PI / 6.0 * d * d * d)));
-  const std::vector<Vector3d> lattice = PourLattice(
-      count, d, 1.1, {-R, -R}, {R, R}, [&](double x, double y) { return x * x + y * y <= (R - 0.6 * d) * (R - 0.6 * d); },
-      p.seed);
-  double top = 0.0;
-  for (const Vector3d& x : lattice) top = std::max(top, x.z());
-  s.AddWall(MakeDiskWall("floor", 1.1 * R, 24));
-  for (DemWall& w : MakeCylinderSideWalls("cylinder", R, top + 2.0 * d, 24)) s.AddWall(std::move(w));
-  DemWall piston = MakeDiskWall("piston", R, 24);
-  piston.position = Vector3d(0, 0, top + d);
-  const int pw = s.AddWall(std::move(piston));
-  for (const Vector3d& x : lattice) s.AddParticle(x);
+  const int pw = AddCylinderBed(&s, R, count, 24, p.seed).lid;  // the lid is the piston
   r.particles = s.num_alive();
   const double mass = r.particles * s.mass(), k_layer = area / (d * d) * p.soil.NormalStiffness();
   try {

@@ -10,6 +10,10 @@
 
 namespace dem_mobility {
 
+/// An open box [0, length] x [0, width] x [0, height]: a floor and four sides, each a flat wall
+/// (floor, x0, x1, y0, y1).
+std::vector<DemWall> MakeOpenBoxWalls(double length, double width, double height);
+
 /// A flat disk of `segments` triangles about the body origin in the x-y plane (a floor or a lid).
 DemWall MakeDiskWall(const std::string& name, double radius, int segments);
 

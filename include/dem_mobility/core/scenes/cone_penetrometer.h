@@ -19,6 +19,7 @@
 
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_mobility/core/scenes/calibration.h"
+#include "dem_mobility/core/scenes/soil_prep.h"
 
 namespace dem_mobility {
 
@@ -146,7 +147,8 @@ class ConePenetrometer {
   Phase phase_ = Phase::kPour;
   double phase_start_ = 0.0;
   // the lid
-  double lid_target_ = 0.0, lid_vmax_ = 0.0, held_ = -1.0, lid_sum_ = 0.0;
+  std::unique_ptr<LidPress> press_;  ///< from the consolidation on
+  double held_ = -1.0, lid_sum_ = 0.0;
   long lid_steps_ = 0;
   double park_z_ = 0.0;
   // the cone: tip height and speed, the PID's integral, the prescribed start

@@ -36,6 +36,17 @@ class LidPress {
   double target_, v_max_;
 };
 
+/// A cylindrical container (axis z, floor at z = 0) with `count` particles of the system's
+/// diameter poured into it from a jittered lattice, and a lid disk just above them.
+struct CylinderBed {
+  int floor = -1, lid = -1;  ///< wall indices
+  double wall_height = 0.0;  ///< of the container's side
+};
+CylinderBed AddCylinderBed(DemSystem* s, double radius, int count, int segments, unsigned seed);
+
+/// The `threads` key of a scene (OpenMP threads, default 1, in [1, 256]).
+int ReadThreads(const YamlReader& y);
+
 /// Checks that `y` is a scene file of `kind` (its `scene:` key) and reads its soil file (`soil:`,
 /// relative to the scene file). ConfigError names the file and key.
 SoilParams ReadSceneSoil(const YamlReader& y, const std::string& kind);
