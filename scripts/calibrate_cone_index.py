@@ -225,6 +225,10 @@ def main():
         sys.exit('calibrate_cone_index: no scene file %s' % a.scene)
     if shutil.which('roslaunch') is None:
         sys.exit('calibrate_cone_index: roslaunch not found: source the catkin workspace (devel/setup.bash) first')
+    if subprocess.run(['rospack', 'find', 'dem_mobility'], stdout=subprocess.DEVNULL,
+                      stderr=subprocess.DEVNULL).returncode != 0:
+        sys.exit('calibrate_cone_index: ROS does not know the package dem_mobility: '
+                 'source the catkin workspace (devel/setup.bash) that built it first')
     os.makedirs(os.path.join(a.out, 'runs'), exist_ok=True)
     runs = [Run(mu, f, a.out, 0) for mu in a.mu for f in a.f]
     pending, running, done = list(runs), [], []

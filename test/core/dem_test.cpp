@@ -169,9 +169,9 @@ TEST(Dem, ParticleRestsOnATriangleFaceEdgeAndVertex) {
 }
 
 // a few hundred particles poured into a box come to rest: slow, barely overlapping, the walls
-// carrying the whole weight. With plasticity, the particles whose largest compression is below
-// their adhesion relax (eq. 16) and so re-expand at up to V_relax: those near the surface never
-// quite stop, so the bound is V_relax there and far tighter without plasticity.
+// carrying the whole weight. With plasticity, the particles pulled harder than they are pressed
+// relax (eq. 16) and so re-expand at up to V_relax: the bound is V_relax there, and far tighter
+// without plasticity.
 DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* carried_fraction) {
   SoilParams p = Nominal();
   p.plasticity = plasticity;
@@ -182,10 +182,16 @@ DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* c
   for (DemWall& w : MakeOpenBoxWalls(L, L, L)) s.AddWall(std::move(w));
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-0.02 * D, 0.02 * D);
-  for (int k = 0; k < 4; ++k)
-    for (int j = 0; j < 10; ++j)
-      for (int i = 0; i < 10; ++i)
-        s.AddParticle(Vector3d((i + 0.5) * 1.05 * D + u(rng), (j + 0.5) * 1.05 * D + u(rng), (k + 0.6) * 1.1 * D));
+  // staggered layers (10 x 10 and 9 x 9, each over the hollows of the one below): a simple-cubic
+  // stack is metastable and, once plastic flattening lets it buckle, collapses in stages for
+  // seconds (the settling then measures the lattice, not the law)
+  for (int k = 0; k < 4; ++k) {
+    const int m = k % 2 ? 9 : 10;
+    const double o = k % 2 ? 1.0 : 0.5;
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i)
+        s.AddParticle(Vector3d((i + o) * 1.05 * D + u(rng), (j + o) * 1.05 * D + u(rng), (k + 0.6) * 1.1 * D));
+  }
   s.Finalize(1.5e-5);
   // 0.45 s; the wall load averaged over the last 0.06 s
   Vector3d carried = Vector3d::Zero();
@@ -198,8 +204,10 @@ DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* c
   for (const Vector3d& v : s.velocities()) *vmax = std::max(*vmax, v.norm());
   *overlap = 0.0;
   const std::vector<Vector3d> x = s.positions();
+  // the effective penetration of each pair: its overlap less both particles' plastic flattening
   for (int i = 0; i < s.size(); ++i)
-    for (int j = i + 1; j < s.size(); ++j) *overlap = std::max(*overlap, (D - (x[i] - x[j]).norm()) / D);
+    for (int j = i + 1; j < s.size(); ++j)
+      *overlap = std::max(*overlap, (D - (x[i] - x[j]).norm() - s.plastic_deformation(i) - s.plastic_deformation(j)) / D);
   *carried_fraction = -carried.z() / (s.size() * p.Mass() * 9.81);
   return s;
 }
@@ -207,14 +215,18 @@ DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* c
 TEST(Dem, PouredBedSettles) {
   double vmax, overlap, carried;
   PourIntoABox(false, &vmax, &overlap, &carried);
-  // pairs rest at the adhesion's reach d0 (fig. 7), plus a little under the weight above
-  const double rest = Nominal().adhesion_depth + 0.01;
+  // pairs rest at the adhesion's reach d0 (fig. 7), plus the elastic give under the weight above:
+  // the whole 4-particle column on one contact is 4 m g / k_n = 3.2e-5 d; allowed 1e-3 d
+  const SoilParams p = Nominal();
+  const double elastic = 4 * p.Mass() * 9.81 / (p.NormalStiffness() * p.diameter);
+  ASSERT_LT(elastic, 1e-4);
+  const double rest = p.adhesion_depth + 1e-3;
   EXPECT_LT(vmax, 1e-3);
   EXPECT_LT(overlap, rest);
   EXPECT_NEAR(carried, 1.0, 0.01);
   PourIntoABox(true, &vmax, &overlap, &carried);
-  EXPECT_LT(vmax, Nominal().relax_speed);
-  EXPECT_LT(overlap, rest + 2 * 0.004);  // + twice fig. 8's plastic strain at the weight's stress
+  EXPECT_LT(vmax, p.relax_speed);
+  EXPECT_LT(overlap, rest);  // beyond both particles' plastic flattening
   EXPECT_NEAR(carried, 1.0, 0.01);
 }
 

@@ -59,31 +59,47 @@ TEST(SoilLaw, PlasticDeformationGrowsAlongFig8AndStaysAfterUnloading) {
   const double stresses[] = {5.0e3, 2.0e4, 3.5e4, 1.0e5};
   const double strains[] = {0.004, 0.012, 0.017, 0.030};  // 3.5e4: halfway between 0.012 and 0.022
   for (int i = 0; i < 4; ++i) {
-    delta = UpdatePlasticDeformation(p, delta, stresses[i] * kA, 1e-5);
+    delta = UpdatePlasticDeformation(p, delta, stresses[i] * kA, 0.0, 1e-5);
     EXPECT_NEAR(delta, strains[i] * kD, 1e-12) << stresses[i];
   }
-  // partial unloading, still pressed at least as hard as the adhesion holds (and below the
-  // 1e5 Pa reached): the deformation stays
+  // partial unloading to 5e3 Pa (below the 1e5 Pa reached), pressed at least as hard as its
+  // contacts pull on it: the deformation stays, even where the pull reaches the particle's
+  // full adhesion (eq. 16 relaxes only under tension or without compression)
   const double f_adh = MaxAdhesionForce(p, delta);
-  ASSERT_LT(f_adh, 1.0e5 * kA);
-  for (int i = 0; i < 1000; ++i) delta = UpdatePlasticDeformation(p, delta, f_adh, 1e-5);
+  ASSERT_GT(f_adh, 5.0e3 * kA);
+  for (int i = 0; i < 1000; ++i) delta = UpdatePlasticDeformation(p, delta, 5.0e3 * kA, 5.0e3 * kA, 1e-5);
   EXPECT_NEAR(delta, 0.030 * kD, 1e-12);
+  for (int i = 0; i < 1000; ++i) delta = UpdatePlasticDeformation(p, delta, f_adh, f_adh, 1e-5);
+  EXPECT_NEAR(delta, 0.030 * kD, 1e-12);
+}
+
+TEST(SoilLaw, RelaxationUnderTensionStopsAtFig8ForThePresentLoad) {
+  const SoilParams p = Nominal();
+  double delta = 0.030 * kD;
+  const double dt = 1e-5;
+  // compressed at 5e3 Pa but pulled harder by an adhesive contact: relaxes at V_relax ...
+  const double pull = 1.5 * 5.0e3 * kA;
+  for (int i = 0; i < 100; ++i) delta = UpdatePlasticDeformation(p, delta, 5.0e3 * kA, pull, dt);
+  EXPECT_NEAR(delta, 0.030 * kD - 100 * 0.045 * dt, 1e-12);
+  // ... down to fig. 8's strain at 5e3 Pa (0.004), where it stops
+  for (int i = 0; i < 100000; ++i) delta = UpdatePlasticDeformation(p, delta, 5.0e3 * kA, pull, dt);
+  EXPECT_NEAR(delta, 0.004 * kD, 1e-12);
 }
 
 TEST(SoilLaw, RelaxationAtVrelaxFlooredAtZero) {
   const SoilParams p = Nominal();
   double delta = 0.030 * kD;
   const double dt = 1e-5;
-  // released (no compression, below the adhesion): eq. 16 removes V_relax dt each step
-  for (int i = 0; i < 100; ++i) delta = UpdatePlasticDeformation(p, delta, 0.0, dt);
+  // released (no compression, no contact): eq. 16 removes V_relax dt each step
+  for (int i = 0; i < 100; ++i) delta = UpdatePlasticDeformation(p, delta, 0.0, 0.0, dt);
   EXPECT_NEAR(delta, 0.030 * kD - 100 * 0.045 * dt, 1e-12);
   // until nothing is left, and no further
-  for (int i = 0; i < 10000; ++i) delta = UpdatePlasticDeformation(p, delta, 0.0, dt);
+  for (int i = 0; i < 10000; ++i) delta = UpdatePlasticDeformation(p, delta, 0.0, 0.0, dt);
   EXPECT_EQ(delta, 0.0);
   // plasticity off: nothing changes
   SoilParams off = p;
   off.plasticity = false;
-  EXPECT_EQ(UpdatePlasticDeformation(off, 0.001, 100.0, dt), 0.001);
+  EXPECT_EQ(UpdatePlasticDeformation(off, 0.001, 0.0, 100.0, dt), 0.001);
 }
 
 TEST(SoilLaw, MaxAdhesionFollowsFig10TimesTheCohesionFactor) {

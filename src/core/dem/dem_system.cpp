@@ -92,6 +92,7 @@ int DemSystem::AddParticle(const Vector3d& x, const Vector3d& v) {
     plastic_.push_back(0.0);
     adhesion_max_.push_back(0.0);
     max_repulsion_.push_back(0.0);
+    max_tension_.push_back(0.0);
     overlap_.push_back(0.0);
     alive_.push_back(0);
     slab_of_.push_back(0);
@@ -114,7 +115,7 @@ int DemSystem::AddParticle(const Vector3d& x, const Vector3d& v) {
   x_built_[p] = x;
   plastic_[p] = 0.0;
   adhesion_max_[p] = MaxAdhesionForce(soil_, 0.0);
-  max_repulsion_[p] = overlap_[p] = 0.0;
+  max_repulsion_[p] = max_tension_[p] = overlap_[p] = 0.0;
   const size_t W = walls_.size();
   for (size_t w = 0; w < W; ++w) {
     wall_hist_[p * W + w] = TangentialHistory();
@@ -153,7 +154,7 @@ void DemSystem::RemoveParticle(int id) {
   }
   alive_[i] = 0;
   f_[i].setZero();
-  max_repulsion_[i] = overlap_[i] = 0.0;
+  max_repulsion_[i] = max_tension_[i] = overlap_[i] = 0.0;
   slot_of_id_[id] = -2 - i;  // removed; its last state stays readable until the slot is reused
   ++removed_;
   free_slots_.insert(std::lower_bound(free_slots_.begin(), free_slots_.end(), i), i);
@@ -239,6 +240,7 @@ void DemSystem::SortSlots(const std::vector<long>& cell) {
   permute(plastic_, 1);
   permute(adhesion_max_, 1);
   permute(max_repulsion_, 1);
+  permute(max_tension_, 1);
   permute(overlap_, 1);
   permute(alive_, 1);
   permute(id_of_slot_, 1);
@@ -544,14 +546,14 @@ void DemSystem::ComputeForces() {
 #pragma omp parallel for schedule(static) num_threads(T)
   for (int i = 0; i < n; ++i) {
     f_[i] = alive_[i] ? weight : Vector3d::Zero();
-    max_repulsion_[i] = overlap_[i] = 0.0;
+    max_repulsion_[i] = max_tension_[i] = overlap_[i] = 0.0;
   }
   // the pairs, slab by slab: the even slabs in parallel, then the odd ones (see the header)
   auto sweep = [&](int i) {
     const Vector3d xi = x_[i], vi = v_[i];
     const double pi = plastic_[i], ai = adhesion_max_[i];
     Vector3d fi = Vector3d::Zero();
-    double max_rep = max_repulsion_[i], max_overlap = overlap_[i];
+    double max_rep = max_repulsion_[i], max_ten = max_tension_[i], max_overlap = overlap_[i];
     for (int k = nbr_begin_[i]; k < nbr_end_[i]; ++k) {
       const int j = nbr_[k];
       const Vector3d r = xi - x_[j];
@@ -585,11 +587,14 @@ void DemSystem::ComputeForces() {
       fi += fc;
       f_[j] -= fc;
       max_rep = std::max(max_rep, fn.repulsion);
+      max_ten = std::max(max_ten, -fn.adhesion);
       max_repulsion_[j] = std::max(max_repulsion_[j], fn.repulsion);
+      max_tension_[j] = std::max(max_tension_[j], -fn.adhesion);
       touching_[k] = 1;
     }
     f_[i] += fi;
     max_repulsion_[i] = max_rep;
+    max_tension_[i] = max_ten;
     overlap_[i] = max_overlap;
   };
   const int ns = static_cast<int>(slab_added_.size());
@@ -631,7 +636,7 @@ void DemSystem::ComputeForces() {
       const Vector3d xi = x_[i], vi = v_[i];
       const double pi = plastic_[i], ai = adhesion_max_[i];
       Vector3d f = f_[i];
-      double max_rep = max_repulsion_[i], max_overlap = overlap_[i];
+      double max_rep = max_repulsion_[i], max_ten = max_tension_[i], max_overlap = overlap_[i];
       // the candidates come in wall order: one pass over them, a group per wall
       auto tri_at = [&](int t) -> const WallTri& { return wall_tris_[fresh ? t : particle_tris_[t]]; };
       int t = t_begin;
@@ -677,6 +682,7 @@ void DemSystem::ComputeForces() {
         const Vector3d fc = fn.Total() * nrm + ft;
         f += fc;
         max_rep = std::max(max_rep, fn.repulsion);
+        max_ten = std::max(max_ten, -fn.adhesion);
         wall_touching_[hw] = 1;
         sum[w].force -= fc;
         sum[w].moment += (q_best - wl.wrench_point).cross(-fc);
@@ -685,6 +691,7 @@ void DemSystem::ComputeForces() {
       }
       f_[i] = f;
       max_repulsion_[i] = max_rep;
+      max_tension_[i] = max_ten;
       overlap_[i] = max_overlap;
     }
   }
@@ -730,7 +737,7 @@ void DemSystem::Step() {
   for (int i = 0; i < n; ++i) {
     if (!alive_[i]) continue;
     v_[i] += h * inv_m * f_[i];
-    const double dp = UpdatePlasticDeformation(soil_, plastic_[i], max_repulsion_[i], dt_);
+    const double dp = UpdatePlasticDeformation(soil_, plastic_[i], max_repulsion_[i], max_tension_[i], dt_);
     if (dp != plastic_[i]) {
       plastic_[i] = dp;
       adhesion_max_[i] = MaxAdhesionForce(soil_, dp);
@@ -824,7 +831,7 @@ DemEnergy DemSystem::Energy() const {
 size_t DemSystem::MemoryBytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   size_t b = bytes(x_) + bytes(v_) + bytes(f_) + bytes(x_built_) + bytes(plastic_) + bytes(adhesion_max_) +
-             bytes(max_repulsion_) + bytes(overlap_) + bytes(alive_) + bytes(id_of_slot_) + bytes(slot_of_id_) +
+             bytes(max_repulsion_) + bytes(max_tension_) + bytes(overlap_) + bytes(alive_) + bytes(id_of_slot_) + bytes(slot_of_id_) +
              bytes(free_slots_) + bytes(nbr_begin_) + bytes(nbr_end_) + bytes(nbr_cap_) + bytes(nbr_) +
              bytes(hist_) + bytes(touching_) + bytes(cell_start_) + bytes(added_since_build_) + bytes(slab_of_) +
              bytes(slab_start_) + bytes(wall_hist_) + bytes(wall_touching_) + bytes(particle_tri_start_) +

@@ -51,16 +51,26 @@ double MaxAdhesionForce(const SoilParams& p, double delta_p) {
   return p.cohesion_factor * p.adhesion_stress_vs_plastic_strain(delta_p / p.diameter) * p.Area();
 }
 
-double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double dt) {
+double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double max_tension,
+                                double dt) {
   if (!p.plasticity) return delta_p;
   const double target = p.plastic_strain_vs_stress(max_repulsion / p.Area()) * p.diameter;
   if (target > delta_p) return target;  // loading beyond the history: the deformation grows (fig. 8)
-  // eq. 16: below the maximum adhesion the deformation relaxes at V_relax, floored at zero, and
-  // here also at what fig. 8 gives for the present load (only the part left from earlier, higher
-  // loads relaxes): relaxing below it would make the next step grow it back by up to V_relax dt,
-  // a force jump of k_n V_relax dt (0.7 N for table 2, more than a particle's weight) that keeps a
-  // lightly loaded particle hopping
-  if (max_repulsion < MaxAdhesionForce(p, delta_p)) return std::max(target, delta_p - p.relax_speed * dt);
+  // eq. 16 relaxes the deformation at V_relax "due to tension and/or removal of the compression":
+  // while the particle's largest compressive force is below the largest tensile (adhesive) force
+  // it carries, both taken over its contacts now (the paper's "maximum force value over all adjacent
+  // particles"), or while nothing compresses it. Compared with the maximum adhesion the particle
+  // could carry (fig. 10), as a literal reading of eq. 16 has it, a consolidated particle would
+  // relax under any load below f x fig. 10: with the tuned fig. 10 (3.5 N at f = 1, 14x a particle's
+  // weight) every particle of a settled bed relaxed, each relaxation step pushing its compressed
+  // contacts apart (work F_repulsion V_relax dt), and a box of poured soil never came to rest
+  // (0.3 m/s at f = 1, 1 m/s at f = 12; docs/soil-model.md). Relaxing under tension is nearly
+  // work-free instead: it deepens the adhesive contacts as much as it loads the compressed ones.
+  // Floored at zero and at what fig. 8 gives for the present load (only the part left from
+  // earlier, higher loads relaxes): relaxing below it would make the next step grow it back by up
+  // to V_relax dt, a force jump of k_n V_relax dt (0.7 N for table 2) that keeps a lightly loaded
+  // particle hopping.
+  if (max_repulsion < max_tension || max_repulsion <= 0.0) return std::max(target, delta_p - p.relax_speed * dt);
   return delta_p;
 }
 

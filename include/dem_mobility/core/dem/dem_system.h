@@ -192,7 +192,7 @@ class DemSystem {
 
   // particles by slot; alive_: 0 free, 1 listed at the last build, 2 added since
   std::vector<Eigen::Vector3d> x_, v_, f_, x_built_;
-  std::vector<double> plastic_, adhesion_max_, max_repulsion_, overlap_;
+  std::vector<double> plastic_, adhesion_max_, max_repulsion_, max_tension_, overlap_;
   std::vector<unsigned char> alive_;
   std::vector<int> id_of_slot_, slot_of_id_, free_slots_;  ///< free_slots_ ascending
   int removed_ = 0;

@@ -1,7 +1,7 @@
 // The cohesive soil particle law of the paper's section 2.3: normal force = adhesion + repulsion +
 // damping (eq. 15, 12b; fig. 7), a per-particle plastic deformation that grows with the particle's
 // largest compressive force (fig. 8), is kept after unloading and relaxes at V_relax while the
-// compression is below the maximum adhesion (eq. 16), a maximum adhesion that grows with the
+// particle's largest compression is below its largest tension (eq. 16), a maximum adhesion that grows with the
 // plastic strain (fig. 10, scaled by the cohesion factor f), and the asperity friction of eq. 13-14
 // (a Coulomb element in parallel with a variable-anchor spring, capped at mu F_repulsion).
 //
@@ -129,10 +129,12 @@ SoilNormalForce ComputeSoilNormalForce(const SoilParams& p, double d, double d_d
 double MaxAdhesionForce(const SoilParams& p, double delta_p);
 
 /// One step of a particle's plastic deformation: grows to fig. 8 at the stress of its largest
-/// repulsive force (never shrinks from loading), and relaxes by V_relax dt while that force is below
-/// the particle's maximum adhesion (eq. 16), floored at zero and at fig. 8's value for the present
+/// repulsive force `max_repulsion` (never shrinks from loading), and relaxes by V_relax dt (eq. 16)
+/// while that force is below the largest adhesive (tensile) force `max_tension` its contacts carry
+/// now, or while it has no compression at all; floored at zero and at fig. 8's value for the present
 /// load (see soil_law.cpp). Unchanged when plasticity is off.
-double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double dt);
+double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double max_tension,
+                                double dt);
 
 
 /// Tangential force (eq. 13-14) of a contact with unit normal `n` (from the other body toward
