@@ -128,8 +128,11 @@ def fit(points, table_ci):
         rows = [round(lo, 1)] + rows
     if rows[-1] < hi:
         rows.append(round(hi, 1))
-    method = 'cubic fit f(CI) (degree %d), as the paper' % deg
-    vals = [float(np.polyval(coef, c)) for c in rows]
+    method = 'cubic fit f(CI) (degree %d), as the paper, clamped to the f range run' % deg
+    # clamped to the f range run: at the ends of the range the runs themselves are exact, and a
+    # least-squares cubic in f misses a small f by far more than its size (f(30.6) = 0.007 for
+    # a run at f = 0.05), which the scenes would refuse
+    vals = [min(max(float(np.polyval(coef, c)), float(f.min())), float(f.max())) for c in rows]
     if any(v <= 0 for v in vals) or any(b <= a for a, b in zip(vals, vals[1:])):
         # the cubic is not monotone (or not positive) over the range: interpolate the runs instead,
         # linearly in log f over the CI-sorted points made monotone

@@ -1,8 +1,18 @@
 #!/usr/bin/env bash
-# Runs the road scene with rviz under a virtual display (Xvfb) and saves what a user sees:
-#   ./scripts/rviz_screenshot.sh [OUT.png] [seconds into the run] [roslaunch args...]
+# Runs a scene with rviz under a virtual display (Xvfb) and saves what a user sees:
+#   ./scripts/rviz_screenshot.sh [OUT.png] [seconds into the run] [LAUNCH.launch] [roslaunch args...]
+# LAUNCH defaults to road_slope.launch (run paced at real time, rviz on). Examples:
+#   ./scripts/rviz_screenshot.sh docs/rviz-cone.png 40 cone_penetrometer.launch fidelity:=tiny f:=5
+#   ./scripts/rviz_screenshot.sh docs/rviz-cone-replay.png 8 replay.launch bag:=$HOME/.ros/dem_mobility/cone_penetrometer.bag view:=cone
 source "$(dirname "$0")/lib.sh"
 out="${1:-$DM_ROOT/docs/rviz-road-slope.png}"; at="${2:-12}"; shift $(( $# > 2 ? 2 : $# ))
+launch_file=road_slope.launch
+if [[ "${1:-}" == *.launch ]]; then launch_file="$1"; shift; fi
+case "$launch_file" in
+  road_slope.launch) extra=(rviz:=true pace:=1 duration:=30) ;;
+  replay.launch) extra=() ;;
+  *) extra=(rviz:=true) ;;
+esac
 ensure_packages "${DM_ROS_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
 build_catkin >/dev/null
 ros_env
@@ -12,8 +22,10 @@ xvfb=$!
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])')
 tmp="$(mktemp -d)"
 trap 'kill $launch $xvfb 2>/dev/null; rm -rf "$tmp"' EXIT
+bag_arg=(bag:="$tmp/run.bag")  # unless the caller names one (to replay it later)
+[[ "$launch_file" == replay.launch || " $* " == *" bag:="* ]] && bag_arg=()
 DISPLAY="$display" LIBGL_ALWAYS_SOFTWARE=1 ROS_MASTER_URI="http://localhost:$port" \
-  roslaunch -p "$port" dem_mobility road_slope.launch rviz:=true pace:=1 duration:=30 bag:="$tmp/run.bag" "$@" \
+  roslaunch -p "$port" dem_mobility "$launch_file" "${extra[@]}" "${bag_arg[@]}" "$@" \
   >"$tmp/launch.log" 2>&1 &
 launch=$!
 sleep "$at"
