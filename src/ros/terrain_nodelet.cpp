@@ -319,7 +319,7 @@ class TerrainNodelet : public nodelet::Nodelet {
     text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
     text.action = visualization_msgs::Marker::ADD;
     text.pose.orientation.w = 1.0;
-    text.pose.position.z = cone_params_.level.soil_depth + 0.3;  // above the poured soil
+    text.pose.position.z = -0.25;  // under the container's floor, clear of the rod and the soil
     text.scale.z = 0.12;
     text.color.r = text.color.g = text.color.b = text.color.a = 1.0f;
     char buf[160];
