@@ -64,8 +64,9 @@ double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_
   // relax under any load below f x fig. 10: with the tuned fig. 10 (3.5 N at f = 1, 14x a particle's
   // weight) every particle of a settled bed relaxed, each relaxation step pushing its compressed
   // contacts apart (work F_repulsion V_relax dt), and a box of poured soil never came to rest
-  // (0.3 m/s at f = 1, 1 m/s at f = 12; docs/soil-model.md). Relaxing under tension is nearly
-  // work-free instead: it deepens the adhesive contacts as much as it loads the compressed ones.
+  // (0.3 m/s at f = 1, 1 m/s at f = 12; docs/soil-model.md). Relaxing only while tension
+  // dominates puts little net work in: what it adds at the compressed contacts it takes back at
+  // the adhesive ones, which it deepens.
   // Floored at zero and at what fig. 8 gives for the present load (only the part left from
   // earlier, higher loads relaxes): relaxing below it would make the next step grow it back by up
   // to V_relax dt, a force jump of k_n V_relax dt (0.7 N for table 2) that keeps a lightly loaded
