@@ -134,7 +134,7 @@ TEST(DemParticles, EmitAndRemoveStreamIsDeterministicAcrossThreads) {
   }
   // adding does not rebuild the lists (only a neighbour's full list would)
   EXPECT_LT(a.overflow_builds(), adds1 / 20) << adds1 << " added, " << a.neighbour_builds() << " builds";
-  const DemEnergy e = a.Energy();
+  const EnergyReport e = a.Energy();
   EXPECT_GT(e.dissipated, 0.0);
 }
 
@@ -159,7 +159,7 @@ TEST(DemParticles, WallWorkEqualsTheEnergyAPistonGives) {
   }
   const double v_out = 2 * U - v;
   EXPECT_NEAR(s.velocity(id).x(), v_out, 1e-3 * v_out);
-  const DemEnergy e = s.Energy();
+  const EnergyReport e = s.Energy();
   const double gained = 0.5 * m * (v_out * v_out - v * v);
   EXPECT_NEAR(e.wall_work, gained, 2e-3 * gained);
   EXPECT_NEAR(e.dissipated, 0.0, 2e-3 * gained);

@@ -6,34 +6,12 @@
 #include <cmath>
 
 #include "dem_mobility/core/common/error.h"
-#include "dem_mobility/core/multibody/elements.h"
+#include "dem_mobility/core/common/time_step.h"
 
 namespace dem_mobility {
 
 using Eigen::Vector3d;
 
-namespace {
-// closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5)
-Vector3d ClosestPointOnTriangle(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
-  const Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return a;
-  const Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + (d1 / (d1 - d3)) * ab;
-  const Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + (d2 / (d2 - d6)) * ac;
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-  const double denom = 1.0 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
-}
-}  // namespace
 
 DemSystem::DemSystem(const SoilParams& soil, const DemSettings& settings)
     : soil_(soil), settings_(settings), law_(soil) {
@@ -492,7 +470,7 @@ double DemSystem::MaxWallDisplacement() const {
   return std::sqrt(m2);
 }
 
-DemStepLimit DemSystem::CriticalTimeStep() const {
+TimeStepLimit DemSystem::CriticalTimeStep() const {
   // the stiffest branch (repulsion k_n or the anchor spring k_t; the adhesion ramp f_max / peak
   // where it is stiffer) acting from every neighbour at once on one particle
   const double z = settings_.max_coordination;
@@ -509,15 +487,16 @@ DemStepLimit DemSystem::CriticalTimeStep() const {
   }
   const double omega = std::sqrt(z * k / mass_);
   const double zeta = z * soil_.NormalDamping() / (2.0 * std::sqrt(z * k * mass_));
-  DemStepLimit lim;
+  TimeStepLimit lim;
   lim.dt_crit = CriticalStep(omega, zeta);
+  lim.element = "soil particle contact";
   lim.detail = detail::Concat(branch, " stiffness ", k, " N/m from ", settings_.max_coordination,
                               " neighbours on a particle of ", mass_, " kg (damping ratio ", zeta, ")");
   return lim;
 }
 
 void DemSystem::Finalize(double dt) {
-  const DemStepLimit lim = CriticalTimeStep();
+  const TimeStepLimit lim = CriticalTimeStep();
   DM_THROW_UNLESS(std::isfinite(dt) && dt > 0.0, "DEM time step ", dt, " s must be positive");
   DM_THROW_UNLESS(dt <= lim.dt_crit, "DEM time step ", dt, " s is above the critical step ", lim.dt_crit, " s (",
                   lim.detail, "); use dt <= ", lim.dt_crit, " s");
@@ -798,8 +777,8 @@ double DemSystem::PairEnergy(int i, int k) const {
   return u;
 }
 
-DemEnergy DemSystem::Mechanical() const {
-  DemEnergy e;
+EnergyReport DemSystem::Mechanical() const {
+  EnergyReport e;
   for (size_t i = 0; i < x_.size(); ++i) {
     if (!alive_[i]) continue;
     e.kinetic += 0.5 * mass_ * v_[i].squaredNorm();
@@ -819,8 +798,8 @@ double DemSystem::ParticleEnergy(int i) const {
   return u;
 }
 
-DemEnergy DemSystem::Energy() const {
-  DemEnergy e = Mechanical();
+EnergyReport DemSystem::Energy() const {
+  EnergyReport e = Mechanical();
   if (!finalized_) return e;
   e.wall_work = wall_work_;
   e.exchanged = exchanged_;

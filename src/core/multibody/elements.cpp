@@ -12,11 +12,6 @@ namespace dem_mobility {
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
-double CriticalStep(double omega, double zeta) {
-  if (!(omega > 0.0)) return std::numeric_limits<double>::infinity();
-  return (2.0 / omega) * (std::sqrt(1.0 + zeta * zeta) - zeta);
-}
-
 double InverseEffectiveMass(const RigidBody& b, const Vector3d& r) {
   if (b.fixed) return 0.0;
   // largest eigenvalue of the point's inverse mass matrix I/m + S(r)^T I_w^-1 S(r)

@@ -25,29 +25,12 @@
 #include <string>
 #include <vector>
 
+#include "dem_mobility/core/common/energy.h"
+#include "dem_mobility/core/common/time_step.h"
 #include "dem_mobility/core/dem/soil_law.h"
-#include "dem_mobility/core/multibody/trimesh.h"
+#include "dem_mobility/core/geometry/trimesh.h"
 
 namespace dem_mobility {
-
-/// Energy bookkeeping of the particles.
-struct DemEnergy {
-  double kinetic = 0.0;
-  double gravitational = 0.0;  ///< -m g . x summed
-  double elastic = 0.0;        ///< repulsion and adhesion branches and tangential springs
-  double Total() const { return kinetic + gravitational + elastic; }
-  // the ledger since Finalize(): work put in from outside, and what the contacts dissipated
-  double wall_work = 0.0;      ///< work of the walls on the particles (trapezoidal in time)
-  double exchanged = 0.0;      ///< energy of particles added less that of particles removed
-  double dissipated = 0.0;     ///< wall_work + exchanged - (Total() - Total() at Finalize)
-};
-
-/// The time-step guard of the particles: the stiffest branch over the particle mass at the largest
-/// coordination, with its damping.
-struct DemStepLimit {
-  double dt_crit = 0.0;
-  std::string detail;
-};
 
 /// A rigid triangle mesh the particles touch: a container side, a lid, a cone, a wheel. Its pose
 /// and velocity are set from outside (static, prescribed motion, or driven by a multibody body);
@@ -105,7 +88,7 @@ class DemSystem {
   const DemWall& wall(int w) const { return walls_[w]; }
   int num_walls() const { return static_cast<int>(walls_.size()); }
 
-  DemStepLimit CriticalTimeStep() const;
+  TimeStepLimit CriticalTimeStep() const;
   /// Refuses (ConfigError naming the limit) a step above the critical one; computes the forces.
   void Finalize(double dt);
   /// One step. Throws SimulationError naming the step, the particle (ID) and the quantity when a
@@ -143,8 +126,8 @@ class DemSystem {
   /// Of those, the builds forced by an added particle whose neighbour's list had no room left.
   long overflow_builds() const { return overflow_builds_; }
   int contacts() const;  ///< pairs in contact at the last force evaluation
-  /// The energies now and the ledger since Finalize() (see DemEnergy).
-  DemEnergy Energy() const;
+  /// The energies now and the ledger since Finalize() (see EnergyReport: the ledger is kept).
+  EnergyReport Energy() const;
   /// Bytes held for the particles, neighbour lists, contact histories and walls.
   size_t MemoryBytes() const;
   Eigen::Vector3d Momentum() const;
@@ -172,7 +155,7 @@ class DemSystem {
   bool InsertPair(int i, int j);
   void RemovePair(int i, int j);
   const TangentialHistory* FindHistory(int i, int j) const;
-  DemEnergy Mechanical() const;
+  EnergyReport Mechanical() const;
   double ParticleEnergy(int i) const;
   double PairEnergy(int i, int k) const;
   void ComputeForces();

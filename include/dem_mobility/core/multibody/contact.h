@@ -8,7 +8,8 @@
 #include <vector>
 
 #include "dem_mobility/core/multibody/elements.h"
-#include "dem_mobility/core/multibody/trimesh.h"
+#include "dem_mobility/core/geometry/terrain_mesh.h"
+#include "dem_mobility/core/geometry/tire_geometry.h"
 
 namespace dem_mobility {
 
@@ -64,18 +65,6 @@ struct PointSetContact {
   void Apply(Bodies& bodies, long step);
   double PotentialEnergy(const Bodies& bodies) const;
   StiffnessInfo Stiffness(const Bodies& bodies) const;
-};
-
-/// Geometry of a rigid tire: a triangle mesh built as rings of vertices around the spin axis
-/// (body y), so that only the columns facing the ground need testing.
-struct TireGeometry {
-  double radius = 0.0, width = 0.0, shoulder_radius = 0.0;
-  int n_circ = 0, n_lat = 0;
-  std::vector<double> lat_y, lat_r;  ///< per lateral index: y offset and radius
-  TriMesh mesh;                      ///< vertex index = column * n_lat + lateral index
-  static TireGeometry Make(double radius, double width, double shoulder_radius, int n_circ,
-                           int n_lat);
-  Eigen::Vector3d Vertex(int col, int j) const { return mesh.vertices[col * n_lat + j]; }
 };
 
 /// Contact of a rigid tire (vertices of its mesh as contact points, the paper's master surface)

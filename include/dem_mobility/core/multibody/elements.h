@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "dem_mobility/core/common/table.h"
+#include "dem_mobility/core/common/time_step.h"
 #include "dem_mobility/core/multibody/rigid_body.h"
 
 namespace dem_mobility {
@@ -21,9 +22,6 @@ struct StiffnessInfo {
   double zeta = 0.0;      ///< damping ratio of that mode
   std::string detail;     ///< what limits it (stiffness, lightest body)
 };
-
-/// Critical explicit step of a damped oscillator: (2/omega)(sqrt(1+zeta^2) - zeta).
-double CriticalStep(double omega, double zeta);
 
 /// Largest inverse effective mass of body `b` for a force at world offset `r` from its COM
 /// (over all force directions). Zero for a fixed body.

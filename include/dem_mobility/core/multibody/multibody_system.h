@@ -6,26 +6,13 @@
 #include <string>
 #include <vector>
 
+#include "dem_mobility/core/common/energy.h"
+#include "dem_mobility/core/common/time_step.h"
 #include "dem_mobility/core/multibody/contact.h"
 #include "dem_mobility/core/multibody/elements.h"
 #include "dem_mobility/core/multibody/rigid_body.h"
 
 namespace dem_mobility {
-
-/// Energy bookkeeping of the system.
-struct EnergyReport {
-  double kinetic = 0.0;
-  double gravitational = 0.0;  ///< -m g . x summed
-  double elastic = 0.0;        ///< penalty springs, springs, contacts
-  double Total() const { return kinetic + gravitational + elastic; }
-};
-
-/// The time-step guard's result: the smallest critical step over all elements, and which element.
-struct TimeStepLimit {
-  double dt_crit = 0.0;
-  std::string element;
-  std::string detail;
-};
 
 /// Bodies and force elements integrated by velocity Verlet, the explicit member of the trapezoidal
 /// family (paper eq. 3-5): the velocity update is eq. 3a/4a, positions use x + dt v + dt^2/2 a, and

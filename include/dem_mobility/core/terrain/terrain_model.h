@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "dem_mobility/core/cosim/exchange.h"
-#include "dem_mobility/core/multibody/trimesh.h"
+#include "dem_mobility/core/geometry/trimesh.h"
 
 namespace dem_mobility {
 

@@ -1,23 +1,12 @@
-// Triangle meshes and a static terrain surface with a uniform 2-D grid index.
+// A static terrain surface with a uniform 2-D grid index (the rigid road's triangles).
 #pragma once
 
 #include <Eigen/Core>
-#include <array>
-#include <string>
 #include <vector>
 
+#include "dem_mobility/core/geometry/trimesh.h"
+
 namespace dem_mobility {
-
-/// A plain triangle mesh (vertices and faces, counter-clockwise seen from outside).
-struct TriMesh {
-  std::vector<Eigen::Vector3d> vertices;
-  std::vector<std::array<int, 3>> faces;
-  Eigen::Vector3d FaceNormal(size_t f) const;
-};
-
-/// A flat rectangular road of triangles in the z = 0 plane: [x0, x0+length] x [-width/2, width/2],
-/// split into cells of `cell` metres, two triangles each.
-TriMesh MakeFlatRoad(double x0, double length, double width, double cell);
 
 /// A static terrain surface: a triangle mesh that faces up (+z of its frame), with a uniform grid
 /// over x-y so that a point query only touches the triangles of one cell. Penetration is measured

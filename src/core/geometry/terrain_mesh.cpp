@@ -1,4 +1,4 @@
-#include "dem_mobility/core/multibody/trimesh.h"
+#include "dem_mobility/core/geometry/terrain_mesh.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -12,28 +12,6 @@ namespace dem_mobility {
 
 using Eigen::Vector2d;
 using Eigen::Vector3d;
-
-Vector3d TriMesh::FaceNormal(size_t f) const {
-  const auto& t = faces[f];
-  return (vertices[t[1]] - vertices[t[0]]).cross(vertices[t[2]] - vertices[t[0]]).normalized();
-}
-
-TriMesh MakeFlatRoad(double x0, double length, double width, double cell) {
-  DM_THROW_UNLESS(length > 0 && width > 0 && cell > 0, "road: length, width and cell must be positive");
-  const int nx = std::max(1, static_cast<int>(std::ceil(length / cell)));
-  const int ny = std::max(1, static_cast<int>(std::ceil(width / cell)));
-  TriMesh m;
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i)
-      m.vertices.emplace_back(x0 + length * i / nx, -0.5 * width + width * j / ny, 0.0);
-  auto id = [nx](int i, int j) { return j * (nx + 1) + i; };
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      m.faces.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.faces.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return m;
-}
 
 TerrainMesh::TerrainMesh(TriMesh mesh, double cell, double max_depth)
     : mesh_(std::move(mesh)), cell_(cell), max_depth_(max_depth) {
