@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/scenes/road_scene.h"
+#include "dem_mobility/core/mobility/mobility_scene.h"
 
 using namespace dem_mobility;
 
@@ -19,10 +19,10 @@ struct Figures {
 };
 
 Figures Measure(double dt) {
-  RoadSceneParams p = RoadSceneParams::Read(YamlReader::Load(DM_CONFIG_DIR "/scenes/road_slope.yaml"));
+  MobilityRunParams p = MobilityRunParams::Read(YamlReader::Load(DM_CONFIG_DIR "/scenes/road_slope.yaml"));
   p.grade_deg = 0.0;
   p.time_step = dt;
-  RoadScene scene(p);
+  MobilityRun scene(p);
   Vehicle& v = scene.vehicle();
   MultibodySystem& sys = v.system();
   VehicleCoSim& sim = scene.sim();

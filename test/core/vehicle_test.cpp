@@ -4,25 +4,25 @@
 #include <cmath>
 
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/scenes/road_scene.h"
+#include "dem_mobility/core/mobility/mobility_scene.h"
 
 namespace dem_mobility {
 namespace {
 
-RoadSceneParams Scene(double grade) {
-  RoadSceneParams p = RoadSceneParams::Read(YamlReader::Load(DM_CONFIG_DIR "/scenes/road_slope.yaml"));
+MobilityRunParams Scene(double grade) {
+  MobilityRunParams p = MobilityRunParams::Read(YamlReader::Load(DM_CONFIG_DIR "/scenes/road_slope.yaml"));
   p.grade_deg = grade;
   return p;
 }
 
 TEST(Vehicle, HasThePapersThirtyThreeBodies) {
-  RoadScene s(Scene(0.0));
+  MobilityRun s(Scene(0.0));
   EXPECT_EQ(s.vehicle().system().num_bodies() - 1, 33);  // minus the ground
   EXPECT_NEAR(s.vehicle().system().TotalMass(), 4430.0 + 4 * (50.0 + 19.45 + 5.81 + 23.97) + 2 * 6.0 + 4 * 6.0, 1e-9);
 }
 
 TEST(Vehicle, AtRestWheelLoadsCarryTheWeightSplitByTheCom) {
-  RoadScene s(Scene(0.0));
+  MobilityRun s(Scene(0.0));
   Vehicle& v = s.vehicle();
   MultibodySystem& sys = v.system();
   v.SetBrakeEffort(1.0);
@@ -56,10 +56,10 @@ double PowerBalanceSpeed(const PowertrainParams& pt, double m, double r, double 
 
 TEST(Vehicle, SteadySpeedOnAGradeMatchesThePowerBalance) {
   const double grade = 20.0;
-  RoadSceneParams p = Scene(grade);
+  MobilityRunParams p = Scene(grade);
   p.duration = 25.0;
-  RoadScene s(p);
-  const RoadResult r = s.Run();
+  MobilityRun s(p);
+  const MobilityRunResult r = s.Run();
   ASSERT_TRUE(r.error.empty()) << r.error;
   ASSERT_EQ(r.smg.status, "steady");
   const Vehicle& v = s.vehicle();
@@ -72,10 +72,10 @@ TEST(Vehicle, SteadySpeedOnAGradeMatchesThePowerBalance) {
 }
 
 TEST(Vehicle, AcceleratesAtTheCommandedRateWhileTorqueAllows) {
-  RoadSceneParams p = Scene(0.0);
+  MobilityRunParams p = Scene(0.0);
   p.duration = 8.0;
-  RoadScene s(p);
-  const RoadResult r = s.Run();
+  MobilityRun s(p);
+  const MobilityRunResult r = s.Run();
   ASSERT_TRUE(r.error.empty()) << r.error;
   // after the controller's start-up, v follows 1 m/s^2: compare the slope over t in [3, 8] s
   double v3 = 0, v8 = 0;
@@ -89,11 +89,11 @@ TEST(Vehicle, AcceleratesAtTheCommandedRateWhileTorqueAllows) {
 // A coupling interval of n exchanges with the terrain every n-th step and holds the wrenches in
 // between; at rest on the road the held wrenches still carry the weight.
 TEST(Vehicle, CouplingIntervalExchangesEveryNthStepAndHoldsTheWrenches) {
-  RoadSceneParams p = Scene(0.0);
+  MobilityRunParams p = Scene(0.0);
   p.coupling_interval = 4;
   p.duration = 0.5;
-  RoadScene s(p);
-  const RoadResult r = s.Run();
+  MobilityRun s(p);
+  const MobilityRunResult r = s.Run();
   ASSERT_TRUE(r.error.empty()) << r.error;
   EXPECT_EQ(r.exchanges, r.steps / 4 + 1);  // the opening exchange, then steps 4, 8, ...
   EXPECT_EQ(s.sim().last_exchange_step(), r.steps - r.steps % 4);
@@ -104,11 +104,11 @@ TEST(Vehicle, CouplingIntervalExchangesEveryNthStepAndHoldsTheWrenches) {
 }
 
 TEST(Vehicle, TimeStepAboveTheCriticalOneIsRefused) {
-  RoadSceneParams p = Scene(0.0);
-  RoadScene probe(p);
+  MobilityRunParams p = Scene(0.0);
+  MobilityRun probe(p);
   p.time_step = 1.5 * probe.sim().limit().dt_crit;
   try {
-    RoadScene s(p);
+    MobilityRun s(p);
     FAIL() << "a step above the critical one was accepted";
   } catch (const ConfigError& e) {
     const std::string m = e.what();

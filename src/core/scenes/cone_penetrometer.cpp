@@ -2,14 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-
-#include <yaml-cpp/yaml.h>
+#include <cstdio>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_shapes.h"
-#include "dem_mobility/core/scenes/dem_pour.h"
 #include "dem_mobility/core/scenes/soil_prep.h"
 
 namespace dem_mobility {
@@ -145,16 +142,25 @@ int ConeParams::ParticleCount() const {
 
 double ConeParams::BaseArea() const { return M_PI * 0.25 * base_diameter * base_diameter; }
 
-const char* ConePenetrometer::PhaseName(Phase p) {
-  switch (p) {
-    case Phase::kPour: return "pour";
-    case Phase::kConsolidate: return "consolidate";
-    case Phase::kRetreat: return "retreat";
-    case Phase::kRelease: return "release";
+std::string ConePenetrometer::phase() const {
+  switch (phase_) {
+    case Phase::kPrepare: return SoilPreparation::PhaseName(prep_->phase());
     case Phase::kPenetrate: return "penetrate";
     case Phase::kDone: return "done";
   }
   return "?";
+}
+
+std::string ConePenetrometer::StatusLine() const {
+  char buf[160];
+  if (penetrating()) {
+    const double ci = samples_.empty() ? 0.0 : samples_.back().ci_psi;
+    std::snprintf(buf, sizeof buf, "t %.2f s  %s  tip depth %.3f / %.3f m  CI %.1f psi", dem_->time(),
+                  phase().c_str(), tip_depth(), p_.level.ci_to, ci);
+  } else {
+    std::snprintf(buf, sizeof buf, "t %.2f s  %s", dem_->time(), phase().c_str());
+  }
+  return buf;
 }
 
 ConePenetrometer::ConePenetrometer(const ConeParams& p) : p_(p), wall0_(std::chrono::steady_clock::now()) {
@@ -169,11 +175,11 @@ ConePenetrometer::ConePenetrometer(const ConeParams& p) : p_(p), wall0_(std::chr
   const CylinderBed bed = AddCylinderBed(&s, R, p.ParticleCount(), p.container_segments, p.seed);
   floor_ = bed.floor;
   lid_ = bed.lid;
-  park_z_ = bed.wall_height + 1.0;
+  const double park_z = bed.wall_height + 1.0;
   const double rod_length = p.level.ci_to + 0.5;
   DemWall cone = MakeConeWall("cone", 0.5 * p.base_diameter, p.cone_length, p.cone_segments);
   cone.friction = p.cone_friction;
-  z_tip_ = park_z_ + 1.0;
+  z_tip_ = park_z + 1.0;
   cone.position = Vector3d(0, 0, z_tip_);
   cone.wrench_point = cone.position;
   cone_ = s.AddWall(std::move(cone));
@@ -182,32 +188,20 @@ ConePenetrometer::ConePenetrometer(const ConeParams& p) : p_(p), wall0_(std::chr
   rod.position = Vector3d(0, 0, z_tip_ + p.cone_length);
   rod_ = s.AddWall(std::move(rod));
   s.Finalize(p.level.time_step);
+  SoilPreparationParams prep;
+  prep.settle_time = p.level.settle_time;
+  prep.lid_pressure = p.lid_pressure;
+  prep.lid_speed = p.lid_speed;
+  prep.hold_time = p.level.hold_time;
+  prep.release_time = p.release_time;
+  prep.timeout = 30.0;
+  prep_ = std::make_unique<SoilPreparation>(&s, lid_, M_PI * R * R, park_z, prep, "cone penetrometer");
 }
 
 ConePenetrometer::~ConePenetrometer() = default;
 
 double ConePenetrometer::penetration_force() const {
   return dem_->wall(cone_).force.z() + dem_->wall(rod_).force.z();
-}
-
-void ConePenetrometer::NextPhase(Phase next) {
-  phase_ = next;
-  phase_start_ = dem_->time();
-}
-
-void ConePenetrometer::StepLid() {
-  DemWall& lw = dem_->mutable_wall(lid_);
-  const double dt = p_.level.time_step;
-  if (phase_ == Phase::kConsolidate) {
-    const double fz = dem_->wall(lid_).force.z();
-    const double v = press_->Velocity(fz);
-    lw.velocity = Vector3d(0, 0, v);
-    lw.position.z() += v * dt;
-    if (held_ < 0.0 && fz >= 0.95 * press_->target()) held_ = 0.0;
-  } else {  // retreat
-    lw.velocity = Vector3d(0, 0, p_.lid_speed);
-    lw.position.z() += p_.lid_speed * dt;
-  }
 }
 
 void ConePenetrometer::PlaceCone() {
@@ -241,80 +235,51 @@ void ConePenetrometer::StepCone() {
 }
 
 void ConePenetrometer::Step() {
-  if (phase_ == Phase::kDone) return;
-  DemSystem& s = *dem_;
-  const double d = p_.level.particle_diameter, R = 0.5 * p_.level.container_diameter;
-  if (phase_ == Phase::kConsolidate || phase_ == Phase::kRetreat) StepLid();
-  if (phase_ == Phase::kPenetrate) StepCone();
-  s.Step();
-  const double t = s.time() - phase_start_;
   switch (phase_) {
-    case Phase::kPour:
-      if (t >= p_.level.settle_time - 0.5 * p_.level.time_step) {
-        height_poured_ = LayerHeight(s);
-        const double area = M_PI * R * R;
-        press_ = std::make_unique<LidPress>(p_.lid_pressure * area, p_.lid_speed, p_.level.time_step,
-                                            area / (d * d) * p_.soil.NormalStiffness());
-        s.mutable_wall(lid_).position.z() = TopParticle(s) + 0.6 * d;
-        NextPhase(Phase::kConsolidate);
-      }
+    case Phase::kPrepare:
+      prep_->Step();
+      if (prep_->done()) StartPenetration();
       break;
-    case Phase::kConsolidate:
-      if (held_ >= 0.0) {
-        held_ += p_.level.time_step;
-        lid_sum_ += s.wall(lid_).force.z() / (M_PI * R * R);
-        ++lid_steps_;
-        if (held_ >= p_.level.hold_time) NextPhase(Phase::kRetreat);
-      } else if (t > 30.0) {
-        throw SimulationError("cone penetrometer: the lid did not reach its pressure within 30 s");
-      }
+    case Phase::kPenetrate:
+      StepCone();
+      dem_->Step();
+      Sample();
       break;
-    case Phase::kRetreat:
-      if (s.wall(lid_).position.z() > TopParticle(s) + 0.6 * d && s.wall(lid_).contacts == 0) {
-        DemWall& lw = s.mutable_wall(lid_);
-        lw.velocity.setZero();
-        lw.position.z() = park_z_;
-        NextPhase(Phase::kRelease);
-      } else if (t > 30.0) {
-        throw SimulationError("cone penetrometer: the lid did not come free of the particles within 30 s");
-      }
-      break;
-    case Phase::kRelease:
-      if (t >= p_.release_time - 0.5 * p_.level.time_step) {
-        surface_ = height_consolidated_ = LayerHeight(s);
-        if (surface_ - p_.level.ci_to < 2.0 * d)
-          throw SimulationError("cone penetrometer: the soil settled to " + detail::Concat(surface_) +
-                                " m, too shallow for the CI window's end at a tip depth of " +
-                                detail::Concat(p_.level.ci_to) + " m (pour more: levels." + p_.level.name +
-                                ".soil_depth)");
-        PlaceCone();
-        StepCone();  // cone walls to their start (a jump: the next step rebuilds the lists)
-        z_tip_ = z0_;
-        v_tip_ = -p_.level.cone_speed;
-        NextPhase(Phase::kPenetrate);
-      }
-      break;
-    case Phase::kPenetrate: {
-      sample_force_ += penetration_force();
-      ++sample_steps_;
-      if (s.time() - sample_t_ >= p_.sample_interval - 0.5 * p_.level.time_step) {
-        ConeSample c;
-        c.t = s.time() - t0_;
-        c.depth = tip_depth();
-        c.speed = (sample_z_ - z_tip_) / (s.time() - sample_t_);
-        c.force = sample_force_ / sample_steps_;
-        c.ci_psi = c.force / p_.BaseArea() / kPsi;
-        samples_.push_back(c);
-        sample_force_ = 0.0;
-        sample_steps_ = 0;
-        sample_z_ = z_tip_;
-        sample_t_ = s.time();
-        if (c.depth >= p_.level.ci_to) NextPhase(Phase::kDone);
-      }
-      break;
-    }
     case Phase::kDone: break;
   }
+}
+
+void ConePenetrometer::StartPenetration() {
+  const double d = p_.level.particle_diameter;
+  surface_ = prep_->height_consolidated();
+  if (surface_ - p_.level.ci_to < 2.0 * d)
+    throw SimulationError("cone penetrometer: the soil settled to " + detail::Concat(surface_) +
+                          " m, too shallow for the CI window's end at a tip depth of " + detail::Concat(p_.level.ci_to) +
+                          " m (pour more: levels." + p_.level.name + ".soil_depth)");
+  PlaceCone();
+  StepCone();  // cone walls to their start (a jump: the next step rebuilds the lists)
+  z_tip_ = z0_;
+  v_tip_ = -p_.level.cone_speed;
+  phase_ = Phase::kPenetrate;
+}
+
+void ConePenetrometer::Sample() {
+  const DemSystem& s = *dem_;
+  sample_force_ += penetration_force();
+  ++sample_steps_;
+  if (s.time() - sample_t_ < p_.sample_interval - 0.5 * p_.level.time_step) return;
+  ConeSample c;
+  c.t = s.time() - t0_;
+  c.depth = tip_depth();
+  c.speed = (sample_z_ - z_tip_) / (s.time() - sample_t_);
+  c.force = sample_force_ / sample_steps_;
+  c.ci_psi = c.force / p_.BaseArea() / kPsi;
+  samples_.push_back(c);
+  sample_force_ = 0.0;
+  sample_steps_ = 0;
+  sample_z_ = z_tip_;
+  sample_t_ = s.time();
+  if (c.depth >= p_.level.ci_to) phase_ = Phase::kDone;
 }
 
 ConeResult ConePenetrometer::Run(const std::function<void(const ConePenetrometer&)>& progress, long every) {
@@ -339,9 +304,9 @@ ConeResult ConePenetrometer::Result() const {
   r.requested_ci = p_.requested_ci;
   r.surface_height = surface_;
   const double mass = r.particles * dem_->mass(), area = M_PI * R * R;
-  if (height_poured_ > 0.0) r.density_poured = mass / (area * height_poured_);
-  if (height_consolidated_ > 0.0) r.density_consolidated = mass / (area * height_consolidated_);
-  r.lid_pressure_reached = lid_sum_ / std::max(1L, lid_steps_);
+  if (prep_->height_poured() > 0.0) r.density_poured = mass / (area * prep_->height_poured());
+  if (prep_->height_consolidated() > 0.0) r.density_consolidated = mass / (area * prep_->height_consolidated());
+  r.lid_pressure_reached = prep_->lid_pressure_reached();
   r.samples = samples_;
   // the cone index: the samples in the window, their scatter and their trend with depth
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
@@ -368,50 +333,47 @@ ConeResult ConePenetrometer::Result() const {
     const double vx = sxx / n - (sx / n) * (sx / n);
     if (n > 1 && vx > 0.0) r.ci_trend_psi_per_m = (sxy / n - (sx / n) * (sy / n)) / vx;
   }
-  r.prep_time = phase_ == Phase::kPenetrate || phase_ == Phase::kDone ? t0_ : dem_->time();
+  r.prep_time = penetrating() ? t0_ : dem_->time();
   r.sim_time = dem_->time();
   r.time_step = p_.level.time_step;
   r.steps = dem_->step_count();
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
   r.error = error_;
-  if (r.error.empty() && phase_ != Phase::kDone) r.error = std::string("interrupted in phase ") + PhaseName(phase_);
+  if (r.error.empty() && phase_ != Phase::kDone) r.error = "interrupted in phase " + phase();
   return r;
 }
 
-void WriteConeResult(const ConeResult& r, const ConeParams& p, const std::string& path) {
-  YAML::Emitter e;
-  e.SetDoublePrecision(9);
-  e << YAML::BeginMap;
-  e << YAML::Key << "scene" << YAML::Value << p.file;
-  e << YAML::Key << "fidelity" << YAML::Value << r.level;
-  e << YAML::Key << "cohesion_factor" << YAML::Value << r.cohesion_factor;
-  e << YAML::Key << "friction" << YAML::Value << r.friction;
+ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
+  ResultFile f(p.file, "cone_penetrometer");
+  f.SetStatus(r.error.empty() ? "ok" : (r.error.rfind("interrupted", 0) == 0 ? "interrupted" : "error"), r.error);
+  f.Set("fidelity", r.level);
+  f.Set("cohesion_factor", r.cohesion_factor);
+  f.Set("friction", r.friction);
   if (std::isfinite(r.requested_ci)) {
-    e << YAML::Key << "requested_cone_index_psi" << YAML::Value << r.requested_ci;
-    e << YAML::Key << "calibration" << YAML::Value << p.calibration_file;
+    f.Set("requested_cone_index_psi", r.requested_ci);
+    f.Set("calibration", p.calibration_file);
   }
-  e << YAML::Key << "cone_index_psi" << YAML::Value << r.ci_psi;
-  e << YAML::Key << "cone_index_std_psi" << YAML::Value << r.ci_std_psi;
-  e << YAML::Key << "cone_index_trend_psi_per_m" << YAML::Value << r.ci_trend_psi_per_m;
-  e << YAML::Key << "ci_window" << YAML::Value << YAML::Flow << std::vector<double>{p.level.ci_from, p.level.ci_to};
-  e << YAML::Key << "window_samples" << YAML::Value << r.window_samples;
-  e << YAML::Key << "cone_speed_min" << YAML::Value << r.speed_min;
-  e << YAML::Key << "cone_speed_max" << YAML::Value << r.speed_max;
-  e << YAML::Key << "particles" << YAML::Value << r.particles;
-  e << YAML::Key << "particle_diameter" << YAML::Value << p.level.particle_diameter;
-  e << YAML::Key << "container_diameter" << YAML::Value << p.level.container_diameter;
-  e << YAML::Key << "surface_height" << YAML::Value << r.surface_height;
-  e << YAML::Key << "bulk_density_poured" << YAML::Value << r.density_poured;
-  e << YAML::Key << "bulk_density_consolidated" << YAML::Value << r.density_consolidated;
-  e << YAML::Key << "lid_pressure_reached" << YAML::Value << r.lid_pressure_reached;
-  e << YAML::Key << "time_step" << YAML::Value << r.time_step;
-  e << YAML::Key << "steps" << YAML::Value << r.steps;
-  e << YAML::Key << "preparation_time" << YAML::Value << r.prep_time;
-  e << YAML::Key << "simulated_time" << YAML::Value << r.sim_time;
-  e << YAML::Key << "wall_time" << YAML::Value << r.wall_time;
-  e << YAML::Key << "threads" << YAML::Value << p.threads;
-  e << YAML::Key << "error" << YAML::Value << r.error;
-  // the CI history (fig. 13): one row per sample
+  f.Set("cone_index_psi", r.ci_psi);
+  f.Set("cone_index_std_psi", r.ci_std_psi);
+  f.Set("cone_index_trend_psi_per_m", r.ci_trend_psi_per_m);
+  f.SetFlow("ci_window", {p.level.ci_from, p.level.ci_to});
+  f.Set("window_samples", r.window_samples);
+  f.Set("cone_speed_min", r.speed_min);
+  f.Set("cone_speed_max", r.speed_max);
+  f.Set("particles", r.particles);
+  f.Set("particle_diameter", p.level.particle_diameter);
+  f.Set("container_diameter", p.level.container_diameter);
+  f.Set("surface_height", r.surface_height);
+  f.Set("bulk_density_poured", r.density_poured);
+  f.Set("bulk_density_consolidated", r.density_consolidated);
+  f.Set("lid_pressure_reached", r.lid_pressure_reached);
+  f.Set("time_step", r.time_step);
+  f.Set("steps", r.steps);
+  f.Set("preparation_time", r.prep_time);
+  f.Set("simulated_time", r.sim_time);
+  f.Set("wall_time", r.wall_time);
+  f.Set("threads", p.threads);
+  // the CI history (fig. 13): one column per quantity
   std::vector<double> t, depth, speed, force, ci;
   for (const ConeSample& c : r.samples) {
     t.push_back(c.t);
@@ -420,17 +382,10 @@ void WriteConeResult(const ConeResult& r, const ConeParams& p, const std::string
     force.push_back(c.force);
     ci.push_back(c.ci_psi);
   }
-  e << YAML::Key << "history" << YAML::Value << YAML::BeginMap;
-  e << YAML::Key << "t" << YAML::Value << YAML::Flow << t;
-  e << YAML::Key << "tip_depth" << YAML::Value << YAML::Flow << depth;
-  e << YAML::Key << "speed" << YAML::Value << YAML::Flow << speed;
-  e << YAML::Key << "force" << YAML::Value << YAML::Flow << force;
-  e << YAML::Key << "ci_psi" << YAML::Value << YAML::Flow << ci;
-  e << YAML::EndMap;
-  e << YAML::EndMap;
-  std::ofstream out(path);
-  if (!out) throw ConfigError(path + ": cannot write the result file");
-  out << e.c_str() << "\n";
+  f.SetColumns("history", {{"t", t}, {"tip_depth", depth}, {"speed", speed}, {"force", force}, {"ci_psi", ci}});
+  return f;
 }
+
+ResultFile ConePenetrometer::Report() const { return ConeResultFile(Result(), p_); }
 
 }  // namespace dem_mobility

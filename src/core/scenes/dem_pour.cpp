@@ -3,12 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <memory>
 
-#include <yaml-cpp/yaml.h>
-
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/scenes/soil_prep.h"
@@ -43,18 +41,6 @@ DemPourParams DemPourParams::Read(const YamlReader& y) {
   return p;
 }
 
-double LayerHeight(const DemSystem& s) {
-  std::vector<double> z;
-  z.reserve(s.size());
-  s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) { z.push_back(x.z()); });
-  if (z.empty()) return 0.0;
-  const size_t top = std::max<size_t>(1, z.size() / 20);
-  std::partial_sort(z.begin(), z.begin() + top, z.end(), std::greater<double>());
-  double sum = 0.0;
-  for (size_t i = 0; i < top; ++i) sum += z[i];
-  return sum / top + 0.5 * s.soil().diameter;
-}
-
 DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* keep) {
   DemPourResult r;
   const auto wall0 = std::chrono::steady_clock::now();
@@ -79,54 +65,27 @@ DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* kee
   r.particles = s.size();
   r.time_step = p.time_step;
   const double mass = s.size() * s.mass(), area = L * W;
+  SoilPreparationParams sp;
+  sp.settle_time = p.settle_time;
+  sp.lid_pressure = p.lid_pressure;
+  sp.lid_speed = p.lid_speed;
+  sp.hold_time = p.hold_time;
+  sp.release_time = p.release_time;
+  sp.timeout = 60.0;
+  std::unique_ptr<SoilPreparation> prep;
   try {
     s.Finalize(p.time_step);
-    auto run_for = [&](double t) {
-      const long n = std::lround(t / p.time_step);
-      for (long i = 0; i < n; ++i) s.Step();
-    };
-    run_for(p.settle_time);
-    r.height_poured = LayerHeight(s);
-    r.density_poured = mass / (area * r.height_poured);
-    // the lid settles on the target pressure (LidPress); the hold time counts from when the
-    // particles first carry 95 % of the force
-    const double target = p.lid_pressure * area;
-    DemWall& lw = s.mutable_wall(lid_index);
-    lw.position.z() = TopParticle(s) + 0.6 * D;  // just clear of the highest particle
-    const LidPress press(target, p.lid_speed, p.time_step, area / (D * D) * p.soil.NormalStiffness());
-    double held = -1.0, pressure_sum = 0.0;
-    long hold_steps = 0;
-    const double t_limit = s.time() + 60.0;
-    while (held < p.hold_time) {
-      const double fz = s.wall(lid_index).force.z();  // the particles push the lid up
-      const double v = press.Velocity(fz);
-      lw.velocity = Vector3d(0, 0, v);
-      lw.position.z() += v * p.time_step;
-      s.Step();
-      if (held < 0.0 && fz >= 0.95 * target) held = 0.0;
-      if (held >= 0.0) {
-        held += p.time_step;
-        pressure_sum += s.wall(lid_index).force.z() / area;
-        ++hold_steps;
-      }
-      if (s.time() > t_limit) throw SimulationError("the lid did not reach its pressure within 60 s");
-    }
-    r.lid_pressure_reached = pressure_sum / std::max(1L, hold_steps);
-    // the lid goes back up at lid_speed until it is one diameter clear of every particle, then away
-    for (;;) {
-      if (lw.position.z() > TopParticle(s) + 0.6 * D && s.wall(lid_index).contacts == 0) break;
-      lw.velocity = Vector3d(0, 0, p.lid_speed);
-      lw.position.z() += p.lid_speed * p.time_step;
-      s.Step();
-      if (s.time() > t_limit + 60.0) throw SimulationError("the lid did not come free of the particles within 60 s");
-    }
-    lw.velocity.setZero();
-    lw.position.z() = H + a;
-    run_for(p.release_time);
-    r.height_consolidated = LayerHeight(s);
-    r.density_consolidated = mass / (area * r.height_consolidated);
+    prep = std::make_unique<SoilPreparation>(&s, lid_index, area, H + a, sp, "dem_pour");
+    while (!prep->done()) prep->Step();
   } catch (const SimulationError& e) {
     r.error = e.what();
+  }
+  if (prep) {
+    r.height_poured = prep->height_poured();
+    if (r.height_poured > 0.0) r.density_poured = mass / (area * r.height_poured);
+    r.lid_pressure_reached = prep->lid_pressure_reached();
+    r.height_consolidated = prep->height_consolidated();
+    if (r.height_consolidated > 0.0) r.density_consolidated = mass / (area * r.height_consolidated);
   }
   double strain = 0.0;
   for (double dp : s.plastic_deformations()) strain += dp / D;
@@ -138,28 +97,22 @@ DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* kee
   return r;
 }
 
-void WriteDemPourResult(const DemPourResult& r, const DemPourParams& p, const std::string& path) {
-  YAML::Emitter e;
-  e << YAML::BeginMap;
-  e << YAML::Key << "scene" << YAML::Value << p.file;
-  e << YAML::Key << "particles" << YAML::Value << r.particles;
-  e << YAML::Key << "layer_height_poured" << YAML::Value << r.height_poured;
-  e << YAML::Key << "bulk_density_poured" << YAML::Value << r.density_poured;
-  e << YAML::Key << "lid_pressure_reached" << YAML::Value << r.lid_pressure_reached;
-  e << YAML::Key << "layer_height_consolidated" << YAML::Value << r.height_consolidated;
-  e << YAML::Key << "bulk_density_consolidated" << YAML::Value << r.density_consolidated;
-  e << YAML::Key << "mean_plastic_strain" << YAML::Value << r.mean_plastic_strain;
-  e << YAML::Key << "time_step" << YAML::Value << r.time_step;
-  e << YAML::Key << "steps" << YAML::Value << r.steps;
-  e << YAML::Key << "simulated_time" << YAML::Value << r.sim_time;
-  e << YAML::Key << "wall_time" << YAML::Value << r.wall_time;
-  e << YAML::Key << "particle_steps_per_second" << YAML::Value
-    << (r.wall_time > 0 ? r.particles * static_cast<double>(r.steps) / r.wall_time : 0.0);
-  e << YAML::Key << "error" << YAML::Value << r.error;
-  e << YAML::EndMap;
-  std::ofstream out(path);
-  if (!out) throw ConfigError(path + ": cannot write the result file");
-  out << e.c_str() << "\n";
+ResultFile DemPourResultFile(const DemPourResult& r, const DemPourParams& p) {
+  ResultFile f(p.file, "dem_pour");
+  f.SetStatus(r.error.empty() ? "ok" : "error", r.error);
+  f.Set("particles", r.particles);
+  f.Set("layer_height_poured", r.height_poured);
+  f.Set("bulk_density_poured", r.density_poured);
+  f.Set("lid_pressure_reached", r.lid_pressure_reached);
+  f.Set("layer_height_consolidated", r.height_consolidated);
+  f.Set("bulk_density_consolidated", r.density_consolidated);
+  f.Set("mean_plastic_strain", r.mean_plastic_strain);
+  f.Set("time_step", r.time_step);
+  f.Set("steps", r.steps);
+  f.Set("simulated_time", r.sim_time);
+  f.Set("wall_time", r.wall_time);
+  f.Set("particle_steps_per_second", r.wall_time > 0 ? r.particles * static_cast<double>(r.steps) / r.wall_time : 0.0);
+  return f;
 }
 
 }  // namespace dem_mobility

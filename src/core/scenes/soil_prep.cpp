@@ -43,6 +43,117 @@ double LidPress::Velocity(double fz) const {
   return std::clamp(-v_max_ * (target_ - fz) / target_, -v_max_, v_max_);
 }
 
+LidHold::LidHold(DemSystem* s, int lid, double area, double pressure, double max_speed, Start start)
+    : s_(s),
+      lid_(lid),
+      area_(area),
+      start_(start),
+      press_(pressure * area, max_speed, s->dt(),
+             area / (s->soil().diameter * s->soil().diameter) * s->soil().NormalStiffness()) {}
+
+void LidHold::Step() {
+  DemWall& w = s_->mutable_wall(lid_);
+  const double fz = w.force.z();  // the particles push the lid up
+  const double v = press_.Velocity(fz);
+  w.velocity = Vector3d(0, 0, v);
+  w.position.z() += v * s_->dt();
+  s_->Step();
+  if (held_ < 0.0) {
+    const double target = press_.target();
+    const bool start = start_ == Start::kReaches95Percent ? fz >= 0.95 * target : std::abs(fz - target) <= 0.05 * target;
+    if (start) held_ = 0.0;
+  }
+  if (held_ >= 0.0) {
+    held_ += s_->dt();
+    sum_pressure_ += s_->wall(lid_).force.z() / area_;
+    sum_height_ += s_->wall(lid_).position.z();
+    ++samples_;
+  }
+}
+
+SoilPreparation::SoilPreparation(DemSystem* s, int lid, double area, double park_z, const SoilPreparationParams& p,
+                                 const std::string& who)
+    : s_(s), lid_(lid), area_(area), park_z_(park_z), p_(p), who_(who) {}
+
+const char* SoilPreparation::PhaseName(Phase p) {
+  switch (p) {
+    case Phase::kPour: return "pour";
+    case Phase::kConsolidate: return "consolidate";
+    case Phase::kRetreat: return "retreat";
+    case Phase::kRelease: return "release";
+    case Phase::kDone: return "done";
+  }
+  return "?";
+}
+
+void SoilPreparation::NextPhase(Phase next) {
+  phase_ = next;
+  phase_steps_ = 0;
+}
+
+void SoilPreparation::Step() {
+  const double dt = s_->dt(), d = s_->soil().diameter;
+  auto steps_of = [dt](double t) { return std::lround(t / dt); };
+  switch (phase_) {
+    case Phase::kPour:
+      s_->Step();
+      if (++phase_steps_ >= steps_of(p_.settle_time)) {
+        height_poured_ = LayerHeight(*s_);
+        s_->mutable_wall(lid_).position.z() = TopParticle(*s_) + 0.6 * d;  // just clear of the highest particle
+        hold_ = std::make_unique<LidHold>(s_, lid_, area_, p_.lid_pressure, p_.lid_speed,
+                                          LidHold::Start::kReaches95Percent);
+        NextPhase(Phase::kConsolidate);
+      }
+      break;
+    case Phase::kConsolidate:
+      hold_->Step();
+      ++phase_steps_;
+      if (hold_->holding() && hold_->held_time() >= p_.hold_time) {
+        NextPhase(Phase::kRetreat);
+      } else if (!hold_->holding() && phase_steps_ * dt > p_.timeout) {
+        throw SimulationError(detail::Concat(who_, ": the lid did not reach its pressure within ", p_.timeout, " s"));
+      }
+      break;
+    case Phase::kRetreat: {
+      // up at lid_speed until it is one diameter clear of every particle, then parked
+      DemWall& w = s_->mutable_wall(lid_);
+      w.velocity = Vector3d(0, 0, p_.lid_speed);
+      w.position.z() += p_.lid_speed * dt;
+      s_->Step();
+      ++phase_steps_;
+      if (s_->wall(lid_).position.z() > TopParticle(*s_) + 0.6 * d && s_->wall(lid_).contacts == 0) {
+        w.velocity.setZero();
+        w.position.z() = park_z_;
+        NextPhase(Phase::kRelease);
+      } else if (phase_steps_ * dt > p_.timeout) {
+        throw SimulationError(
+            detail::Concat(who_, ": the lid did not come free of the particles within ", p_.timeout, " s"));
+      }
+      break;
+    }
+    case Phase::kRelease:
+      s_->Step();
+      if (++phase_steps_ >= steps_of(p_.release_time)) {
+        height_consolidated_ = LayerHeight(*s_);
+        NextPhase(Phase::kDone);
+      }
+      break;
+    case Phase::kDone: break;
+  }
+}
+
+double LayerHeight(const DemSystem& s) {
+  std::vector<double> z;
+  z.reserve(s.size());
+  s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) { z.push_back(x.z()); });
+  if (z.empty()) return 0.0;
+  const size_t top = std::max<size_t>(1, z.size() / 20);
+  std::partial_sort(z.begin(), z.begin() + top, z.end(), std::greater<double>());
+  double sum = 0.0;
+  for (size_t i = 0; i < top; ++i) sum += z[i];
+  return sum / top + 0.5 * s.soil().diameter;
+}
+
 CylinderBed AddCylinderBed(DemSystem* s, double R, int count, int segments, unsigned seed) {
   const double d = s->soil().diameter;
   const std::vector<Vector3d> lattice = PourLattice(

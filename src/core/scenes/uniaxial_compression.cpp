@@ -2,13 +2,12 @@
 
 #include <chrono>
 #include <cmath>
-#include <fstream>
 
 #include <yaml-cpp/yaml.h>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/scenes/dem_pour.h"
 #include "dem_mobility/core/scenes/soil_prep.h"
 
 namespace dem_mobility {
@@ -56,40 +55,27 @@ CompressionResult RunUniaxialCompression(const CompressionParams& p) {
   const int count = static_cast<int>(std::lround(p.solid_fraction * area * p.soil_depth / (M_PI / 6.0 * d * d * d)));
   const int pw = AddCylinderBed(&s, R, count, 24, p.seed).lid;  // the lid is the piston
   r.particles = s.num_alive();
-  const double mass = r.particles * s.mass(), k_layer = area / (d * d) * p.soil.NormalStiffness();
+  const double mass = r.particles * s.mass();
   try {
     s.Finalize(p.time_step);
     for (long n = std::lround(p.settle_time / p.time_step); n > 0; --n) s.Step();
     r.density_poured = mass / (area * LayerHeight(s));
     DemWall& w = s.mutable_wall(pw);
     w.position.z() = TopParticle(s) + 0.6 * d;
-    // each pressure: the piston settles on it (LidPress), holds it, and the density is read from
-    // the piston's height (as in the apparatus)
+    // each pressure: the piston settles on it, holds it, and the density is read from the
+    // piston's height (as in the apparatus)
     auto hold = [&](double pressure) {
-      const LidPress press(pressure * area, p.piston_speed, p.time_step, k_layer);
-      double held = -1.0, sum_p = 0.0, sum_h = 0.0;
-      long n = 0;
+      LidHold h(&s, pw, area, pressure, p.piston_speed, LidHold::Start::kWithin5Percent);
       const double limit = s.time() + 30.0;
-      while (held < p.hold_time) {
-        const double fz = s.wall(pw).force.z();
-        const double v = press.Velocity(fz);
-        w.velocity = Vector3d(0, 0, v);
-        w.position.z() += v * p.time_step;
-        s.Step();
-        if (held < 0.0 && std::abs(fz - press.target()) <= 0.05 * press.target()) held = 0.0;
-        if (held >= 0.0) {
-          held += p.time_step;
-          sum_p += s.wall(pw).force.z() / area;
-          sum_h += w.position.z();
-          ++n;
-        }
+      while (!h.holding() || h.held_time() < p.hold_time) {
+        h.Step();
         if (s.time() > limit)
           throw SimulationError("uniaxial compression: the piston did not settle on " + detail::Concat(pressure) +
                                 " Pa within 30 s");
       }
       CompressionPoint c;
-      c.pressure = sum_p / std::max(1L, n);
-      c.density = mass / (area * sum_h / std::max(1L, n));
+      c.pressure = h.mean_pressure();
+      c.density = mass / h.mean_volume();
       return c;
     };
     for (double pr : p.loading) r.loading.push_back(hold(pr));
@@ -112,29 +98,30 @@ CompressionResult RunUniaxialCompression(const CompressionParams& p) {
   return r;
 }
 
-void WriteCompressionResult(const CompressionResult& r, const CompressionParams& p, const std::string& path) {
-  YAML::Emitter e;
-  e << YAML::BeginMap;
-  e << YAML::Key << "scene" << YAML::Value << p.file;
-  e << YAML::Key << "particles" << YAML::Value << r.particles;
-  e << YAML::Key << "cohesion_factor" << YAML::Value << p.soil.cohesion_factor;
-  e << YAML::Key << "bulk_density_poured" << YAML::Value << r.density_poured;
+ResultFile CompressionResultFile(const CompressionResult& r, const CompressionParams& p) {
+  ResultFile f(p.file, "uniaxial_compression");
+  f.SetStatus(r.error.empty() ? "ok" : "error", r.error);
+  f.Set("particles", r.particles);
+  f.Set("cohesion_factor", p.soil.cohesion_factor);
+  f.Set("bulk_density_poured", r.density_poured);
   auto points = [&](const char* key, const std::vector<CompressionPoint>& v) {
-    e << YAML::Key << key << YAML::Value << YAML::BeginSeq;
-    for (const CompressionPoint& c : v) e << YAML::Flow << std::vector<double>{c.pressure, c.density};
-    e << YAML::EndSeq;
+    YAML::Node n(YAML::NodeType::Sequence);  // rows [pressure Pa, bulk density kg/m^3]
+    for (const CompressionPoint& c : v) {
+      YAML::Node row(YAML::NodeType::Sequence);
+      row.push_back(c.pressure);
+      row.push_back(c.density);
+      row.SetStyle(YAML::EmitterStyle::Flow);
+      n.push_back(row);
+    }
+    f.Set(key, n);
   };
-  points("loading", r.loading);      // [pressure Pa, bulk density kg/m^3]
+  points("loading", r.loading);
   points("unloading", r.unloading);
-  e << YAML::Key << "bulk_density_released" << YAML::Value << r.density_released;
-  e << YAML::Key << "simulated_time" << YAML::Value << r.sim_time;
-  e << YAML::Key << "steps" << YAML::Value << r.steps;
-  e << YAML::Key << "wall_time" << YAML::Value << r.wall_time;
-  e << YAML::Key << "error" << YAML::Value << r.error;
-  e << YAML::EndMap;
-  std::ofstream out(path);
-  if (!out) throw ConfigError(path + ": cannot write the result file");
-  out << e.c_str() << "\n";
+  f.Set("bulk_density_released", r.density_released);
+  f.Set("simulated_time", r.sim_time);
+  f.Set("steps", r.steps);
+  f.Set("wall_time", r.wall_time);
+  return f;
 }
 
 }  // namespace dem_mobility

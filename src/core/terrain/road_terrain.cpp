@@ -1,19 +1,20 @@
-// The rigid polygonal road as a terrain model: the tire vertices of each wheel (the paper's master
-// surface) against the road's triangles (the slave surface), with the asperity friction model.
+#include "dem_mobility/core/terrain/road_terrain.h"
+
+#include <algorithm>
 #include <cmath>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/geometry/terrain_mesh.h"
 #include "dem_mobility/core/multibody/contact.h"
-#include "dem_mobility/core/terrain/terrain_model.h"
-#include "dem_mobility/core/vehicle/vehicle.h"
 
 namespace dem_mobility {
 namespace {
 
 class RoadTerrain final : public TerrainModel {
  public:
-  RoadTerrain(const YamlReader& y, const TireGeometry& tire) : tire_(tire) {
+  RoadTerrain(const YamlReader& y, const TerrainVehicle& vehicle) : tire_(vehicle.tire) {
+    description_ = DescribeRoadTerrain(y);
     const double length = y.Positive("length");
     const double width = y.DoubleIn("width", 3.0, 1000.0);
     const double cell = y.Positive("cell");
@@ -22,12 +23,14 @@ class RoadTerrain final : public TerrainModel {
     const ContactParams params = ContactParams::Read(c);
     c.Finish();
     y.Finish();
+    DM_THROW_UNLESS(vehicle.wheels == kWheels, y.file(), ": rigid_road carries ", kWheels, " wheels, not ",
+                    vehicle.wheels);
     mesh_ = std::make_unique<TerrainMesh>(MakeFlatRoad(start, length, width, cell), cell, 0.05);
-    bodies_.resize(4);
-    for (int i = 0; i < 4; ++i) {
-      bodies_[i].name = std::string("wheel_") + "0123"[i];
+    bodies_.resize(kWheels);
+    for (int i = 0; i < kWheels; ++i) {
+      bodies_[i].name = std::string("wheel_") + kWheelNames[i];
       TireContact& tc = tires_[i];
-      tc.name = "tire " + std::to_string(i);
+      tc.name = std::string("tire_") + kWheelNames[i];
       tc.body = i;
       tc.tire = &tire_;
       tc.params = params;
@@ -36,16 +39,15 @@ class RoadTerrain final : public TerrainModel {
     const int n = tires_[0].SimultaneousVertices();
     stiffness_ = n * std::max(params.k_n, params.k_t);
     damping_ = n * params.c_n;
+    wrenches_.resize(kWheels);
   }
 
-  std::string kind() const override { return "rigid_road"; }
+  const TerrainDescription& description() const override { return description_; }
   const TriMesh& Surface() const override { return mesh_->mesh(); }
 
-  void Compute(long step, double /*t*/, const std::vector<WheelState>& states,
-               std::vector<WheelWrench>* wrenches) override {
-    DM_THROW_UNLESS(states.size() == 4, "rigid_road: expected 4 wheel states, got ", states.size());
-    wrenches->resize(4);
-    for (int i = 0; i < 4; ++i) {
+  void Synchronize(long step, double /*t*/, const std::vector<WheelState>& states) override {
+    DM_THROW_UNLESS(states.size() == kWheels, "rigid_road: expected ", kWheels, " wheel states, got ", states.size());
+    for (int i = 0; i < kWheels; ++i) {
       const WheelState& s = states[i];
       RigidBody& b = bodies_[i];
       b.x = s.position;
@@ -55,7 +57,7 @@ class RoadTerrain final : public TerrainModel {
       b.force.setZero();
       b.torque.setZero();
       tires_[i].Apply(bodies_, step);
-      WheelWrench& w = (*wrenches)[i];
+      WheelWrench& w = wrenches_[i];
       w.force = b.force;
       w.moment = b.torque;
       w.sinkage = tires_[i].last.max_depth;
@@ -65,23 +67,31 @@ class RoadTerrain final : public TerrainModel {
       w.damping = damping_;
     }
   }
+  void GetWrenches(std::vector<WheelWrench>* wrenches) const override { *wrenches = wrenches_; }
+  void Advance(double /*dt*/) override {}
 
  private:
+  TerrainDescription description_;
   TireGeometry tire_;
   std::unique_ptr<TerrainMesh> mesh_;
   Bodies bodies_;  ///< one stand-in body per wheel, holding the exchanged state
-  TireContact tires_[4];
+  TireContact tires_[kWheels];
+  std::vector<WheelWrench> wrenches_;
   double stiffness_ = 0.0, damping_ = 0.0;
 };
 
 }  // namespace
 
-std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const std::string& vehicle_file) {
-  const YamlReader y = YamlReader::Load(terrain_file);
-  const std::string model = y.String("model");
-  if (model == "rigid_road") return std::make_unique<RoadTerrain>(y, LoadTireGeometry(vehicle_file));
-  y.Fail("model", "unknown terrain model '" + model + "' (known: rigid_road)");
-  return nullptr;
+TerrainDescription DescribeRoadTerrain(const YamlReader& y) {
+  TerrainDescription d;
+  d.file = y.file();
+  d.model = y.String("model");
+  d.cone_index = y.DoubleIn("cone_index_psi", 1.0, 1000.0);
+  return d;
+}
+
+std::unique_ptr<TerrainModel> MakeRoadTerrain(const YamlReader& y, const TerrainVehicle& vehicle) {
+  return std::make_unique<RoadTerrain>(y, vehicle);
 }
 
 }  // namespace dem_mobility

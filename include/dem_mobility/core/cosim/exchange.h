@@ -6,9 +6,16 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <limits>
+#include <string>
 #include <vector>
 
 namespace dem_mobility {
+
+/// The wheels, in the order of every exchange, message and result: front left, front right, rear
+/// left, rear right.
+constexpr int kWheels = 4;
+constexpr const char* kWheelNames[kWheels] = {"fl", "fr", "rl", "rr"};
 
 /// State of one wheel in the simulation's world frame: centre, orientation, velocities.
 struct WheelState {
@@ -28,6 +35,13 @@ struct WheelWrench {
   /// Upper bound of the contact's translational stiffness on the wheel [N/m] and its damping
   /// [N s/m]: the vehicle's time-step guard checks its step against them.
   double stiffness = 0.0, damping = 0.0;
+};
+
+/// What a terrain file says it is, without building it (for results and displays).
+struct TerrainDescription {
+  std::string file;
+  std::string model;    ///< its `model:` (rigid_road, ...)
+  double cone_index = std::numeric_limits<double>::quiet_NaN();  ///< soil strength [psi]
 };
 
 /// Vehicle -> driver at every control step.

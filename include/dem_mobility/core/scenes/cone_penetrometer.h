@@ -20,6 +20,7 @@
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_mobility/core/scenes/calibration.h"
 #include "dem_mobility/core/scenes/soil_prep.h"
+#include "dem_mobility/core/scenes/soil_rig.h"
 
 namespace dem_mobility {
 
@@ -99,31 +100,31 @@ struct ConeResult {
   std::string error;                 ///< empty on success
 };
 
-class ConePenetrometer {
+class ConePenetrometer final : public SoilRig {
  public:
-  enum class Phase { kPour, kConsolidate, kRetreat, kRelease, kPenetrate, kDone };
-
   /// Builds the container, the tools and the particles (ConfigError on an unusable setup).
   explicit ConePenetrometer(const ConeParams& p);
-  ~ConePenetrometer();
+  ~ConePenetrometer() override;
 
-  /// One DEM step with the lid or the cone controller; SimulationError on a numerical failure
-  /// (the state stays readable).
-  void Step();
+  // the soil rig
+  const char* kind() const override { return "cone_penetrometer"; }
+  void Step() override;
+  bool done() const override { return phase_ == Phase::kDone; }
+  void Fail(const std::string& error) override { error_ = error; }
+  const DemSystem& dem() const override { return *dem_; }
+  std::string phase() const override;
+  std::string StatusLine() const override;
+  std::vector<int> moving_walls() const override { return {cone_, rod_, lid_}; }
+  ResultFile Report() const override;
+
   /// Steps to the end; `progress(*this)` is called every `every` steps. Numerical failures end
   /// the run with `error` set and what was measured so far.
   ConeResult Run(const std::function<void(const ConePenetrometer&)>& progress = nullptr, long every = 1000);
   /// What was measured so far (the CI window's statistics once the run is past it).
   ConeResult Result() const;
-  /// Marks the run failed (e.g. after a SimulationError out of Step()).
-  void Fail(const std::string& error) { error_ = error; }
 
-  bool done() const { return phase_ == Phase::kDone; }
-  Phase phase() const { return phase_; }
-  static const char* PhaseName(Phase p);
-  const DemSystem& dem() const { return *dem_; }
+  bool penetrating() const { return phase_ != Phase::kPrepare; }
   const ConeParams& params() const { return p_; }
-  /// Walls of the scene and what they are.
   int cone_wall() const { return cone_; }
   int rod_wall() const { return rod_; }
   int lid_wall() const { return lid_; }
@@ -136,24 +137,20 @@ class ConePenetrometer {
   const std::vector<ConeSample>& samples() const { return samples_; }
 
  private:
+  enum class Phase { kPrepare, kPenetrate, kDone };
   void PlaceCone();
   void StepCone();
-  void StepLid();
-  void NextPhase(Phase next);
+  void StartPenetration();
+  void Sample();
 
   ConeParams p_;
   std::unique_ptr<DemSystem> dem_;
+  std::unique_ptr<SoilPreparation> prep_;
   int cone_ = -1, rod_ = -1, lid_ = -1, floor_ = -1;
-  Phase phase_ = Phase::kPour;
-  double phase_start_ = 0.0;
-  // the lid
-  std::unique_ptr<LidPress> press_;  ///< from the consolidation on
-  double held_ = -1.0, lid_sum_ = 0.0;
-  long lid_steps_ = 0;
-  double park_z_ = 0.0;
+  Phase phase_ = Phase::kPrepare;
   // the cone: tip height and speed, the PID's integral, the prescribed start
   double z_tip_ = 0.0, v_tip_ = 0.0, integral_ = 0.0, z0_ = 0.0, t0_ = 0.0;
-  double surface_ = 0.0, height_poured_ = 0.0, height_consolidated_ = 0.0;
+  double surface_ = 0.0;
   // the current sample
   double sample_force_ = 0.0, sample_z_ = 0.0, sample_t_ = 0.0;
   long sample_steps_ = 0;
@@ -162,6 +159,7 @@ class ConePenetrometer {
   std::string error_;
 };
 
-void WriteConeResult(const ConeResult& r, const ConeParams& p, const std::string& path);
+/// The result file (the one schema: scene, kind, status, error, then the figures and the CI history).
+ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p);
 
 }  // namespace dem_mobility

@@ -10,6 +10,7 @@
 
 namespace dem_mobility {
 
+class ResultFile;
 class YamlReader;
 
 struct DemPourParams {
@@ -42,9 +43,7 @@ struct DemPourResult {
 /// Runs the pour, settle, consolidate and release; numerical failures end it with `error` set and
 /// the figures measured so far. With `keep`, the prepared bed is handed over (to run on).
 DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* keep = nullptr);
-void WriteDemPourResult(const DemPourResult& r, const DemPourParams& p, const std::string& path);
-
-/// Height of a particle layer: the mean top of the highest 5 % of the particles.
-double LayerHeight(const DemSystem& s);
+/// The result file (the one schema: scene, kind, status, error, then the figures).
+ResultFile DemPourResultFile(const DemPourResult& r, const DemPourParams& p);
 
 }  // namespace dem_mobility

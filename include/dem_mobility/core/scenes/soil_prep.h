@@ -1,9 +1,13 @@
-// Pieces of the soil preparation that the scenes share (paper sections 3 and 4.2): the loose
-// lattice the particles are poured from, and the lid that consolidates them at a pressure.
+// The soil preparation every soil scene shares (paper sections 3 and 4.2): particles poured from a
+// loose lattice settle under gravity; a lid consolidates them at a pressure (33.3 kPa) for a time
+// (0.5 s) and is removed; the soil settles again. SoilPreparation steps through it; LidHold is the
+// lid's control loop, which the compression test also runs at each of its pressures.
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,6 +39,77 @@ class LidPress {
  private:
   double target_, v_max_;
 };
+
+/// Holds a lid (a DEM wall moving along z, pressing down) at a pressure: each step the lid moves at
+/// LidPress's speed for the force the particles put on it at the last step, then the DEM steps.
+/// The hold counts from the step the force first meets the start criterion; from then on it
+/// averages the pressure and the lid's height.
+class LidHold {
+ public:
+  /// When the hold starts: once the force first reaches 95 % of the target, or once it is within
+  /// 5 % of it.
+  enum class Start { kReaches95Percent, kWithin5Percent };
+  LidHold(DemSystem* s, int lid, double area, double pressure, double max_speed, Start start);
+  void Step();
+  bool holding() const { return held_ >= 0.0; }
+  double held_time() const { return std::max(0.0, held_); }
+  double mean_pressure() const { return sum_pressure_ / std::max(1L, samples_); }  ///< [Pa] over the hold
+  double mean_volume() const { return area_ * sum_height_ / std::max(1L, samples_); }  ///< under the lid [m^3]
+  const LidPress& press() const { return press_; }
+
+ private:
+  DemSystem* s_;
+  int lid_;
+  double area_;
+  Start start_;
+  LidPress press_;
+  double held_ = -1.0, sum_pressure_ = 0.0, sum_height_ = 0.0;
+  long samples_ = 0;
+};
+
+struct SoilPreparationParams {
+  double settle_time = 0.5;      ///< [s] after the pour, before the lid
+  double lid_pressure = 33.3e3;  ///< [Pa]
+  double lid_speed = 0.05;       ///< [m/s] most the lid moves
+  double hold_time = 0.5;        ///< [s] at the pressure
+  double release_time = 0.2;     ///< [s] of settling after the lid is gone
+  double timeout = 30.0;         ///< [s] longest the lid may take to reach its pressure, and to come free
+};
+
+/// The preparation of a poured bed under a lid wall: pour (settle), consolidate, retreat (the lid
+/// goes up until it is clear of the particles, then is parked), release (settle again).
+class SoilPreparation {
+ public:
+  enum class Phase { kPour, kConsolidate, kRetreat, kRelease, kDone };
+  /// `area`: the bed's horizontal area [m^2]; `park_z`: where the lid waits before and after;
+  /// `who`: names the scene in error messages.
+  SoilPreparation(DemSystem* s, int lid, double area, double park_z, const SoilPreparationParams& p,
+                  const std::string& who);
+  /// One DEM step of the current phase. SimulationError when the lid times out (the DEM's own
+  /// watchdogs throw too).
+  void Step();
+  bool done() const { return phase_ == Phase::kDone; }
+  Phase phase() const { return phase_; }
+  static const char* PhaseName(Phase p);
+  double height_poured() const { return height_poured_; }              ///< layer height before the lid [m]
+  double height_consolidated() const { return height_consolidated_; }  ///< after the release [m]
+  double lid_pressure_reached() const { return hold_ ? hold_->mean_pressure() : 0.0; }  ///< [Pa]
+
+ private:
+  void NextPhase(Phase next);
+  DemSystem* s_;
+  int lid_;
+  double area_, park_z_;
+  SoilPreparationParams p_;
+  std::string who_;
+  Phase phase_ = Phase::kPour;
+  long phase_steps_ = 0;
+  std::unique_ptr<LidHold> hold_;
+  double height_poured_ = 0.0, height_consolidated_ = 0.0;
+};
+
+/// Height of a particle layer: the mean top of the highest 5 % of the particles.
+double LayerHeight(const DemSystem& s);
 
 /// A cylindrical container (axis z, floor at z = 0) with `count` particles of the system's
 /// diameter poured into it from a jittered lattice, and a lid disk just above them.

@@ -10,6 +10,7 @@
 
 namespace dem_mobility {
 
+class ResultFile;
 class YamlReader;
 
 struct CompressionParams {
@@ -43,6 +44,7 @@ struct CompressionResult {
 
 /// Runs the test; numerical failures end it with `error` set and what was measured so far.
 CompressionResult RunUniaxialCompression(const CompressionParams& p);
-void WriteCompressionResult(const CompressionResult& r, const CompressionParams& p, const std::string& path);
+/// The result file (the one schema: scene, kind, status, error, then the figures).
+ResultFile CompressionResultFile(const CompressionResult& r, const CompressionParams& p);
 
 }  // namespace dem_mobility

@@ -1,0 +1,54 @@
+// The vehicle side of the lock-step co-simulation: the 33-body vehicle on a grade (gravity
+// rotated; x uphill), stepping in lock-step with a terrain.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "dem_mobility/core/common/time_step.h"
+#include "dem_mobility/core/cosim/ports.h"
+#include "dem_mobility/core/mobility/mobility_run.h"
+#include "dem_mobility/core/vehicle/vehicle.h"
+
+namespace dem_mobility {
+
+class VehicleCoSim {
+ public:
+  explicit VehicleCoSim(const MobilityRunParams& p);
+  /// The opening exchange (step 0), then the time step: time_step, or time_step_safety x the
+  /// smallest critical step of the vehicle's elements and the terrain contact it reported.
+  /// Throws ConfigError (naming the scene file and time_step) for a step above that limit.
+  void Start(TerrainPort& terrain);
+  /// One step; exchanges with the terrain when the step index is a multiple of the interval.
+  void Step(TerrainPort& terrain);
+
+  Vehicle& vehicle() { return *vehicle_; }
+  const Vehicle& vehicle() const { return *vehicle_; }
+  const MobilityRunParams& params() const { return p_; }
+  long step() const { return vehicle_->system().step_count(); }
+  double time() const { return vehicle_->system().time(); }     ///< since the start of settling
+  double driver_time() const { return time() - p_.settle_time; } ///< since the driver's start
+  double dt() const { return dt_; }
+  const TimeStepLimit& limit() const { return limit_; }
+  long settle_steps() const { return settle_steps_; }
+  long exchanges() const { return exchanges_; }
+  long last_exchange_step() const { return last_exchange_; }
+  const std::vector<WheelState>& wheel_states() const { return states_; }
+  const std::vector<WheelWrench>& wheel_wrenches() const { return wrenches_; }
+  /// Gravity for a grade of `deg` uphill toward +x (the terrain frame is the slope frame).
+  static Eigen::Vector3d GradeGravity(double deg);
+
+ private:
+  void Exchange(TerrainPort& terrain);
+  void CheckContactLimit();
+  MobilityRunParams p_;
+  std::unique_ptr<Vehicle> vehicle_;
+  double dt_ = 0.0;
+  TimeStepLimit limit_;
+  long settle_steps_ = 0, exchanges_ = 0, last_exchange_ = -1;
+  double checked_stiffness_ = -1.0, checked_damping_ = -1.0;
+  std::vector<WheelState> states_;
+  std::vector<WheelWrench> wrenches_;
+};
+
+}  // namespace dem_mobility

@@ -1,0 +1,30 @@
+// A mobility run in one process: the vehicle, the scene's terrain model and its driver called
+// directly, through the same loop the nodelets run (cosim/cosim_loop.h).
+#pragma once
+
+#include <memory>
+
+#include "dem_mobility/core/cosim/cosim_loop.h"
+#include "dem_mobility/core/terrain/terrain_model.h"
+
+namespace dem_mobility {
+
+class MobilityRun {
+ public:
+  /// Builds the terrain, the driver and the vehicle, and makes the opening exchange (ConfigError
+  /// for bad input or a time step above the limit).
+  explicit MobilityRun(const MobilityRunParams& p);
+  MobilityRunResult Run(CoSimObserver* observer = nullptr);
+  VehicleCoSim& sim() { return sim_; }
+  Vehicle& vehicle() { return sim_.vehicle(); }
+  TerrainPort& terrain_port() { return port_; }
+  double dt() const { return sim_.dt(); }
+
+ private:
+  std::unique_ptr<TerrainModel> terrain_;
+  LocalTerrainPort port_;
+  SceneDriver driver_;
+  VehicleCoSim sim_;
+};
+
+}  // namespace dem_mobility

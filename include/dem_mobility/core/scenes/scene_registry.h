@@ -1,0 +1,34 @@
+// The scenes there are, by their `scene:` key: each reads its file, runs to the end (printing its
+// progress and a summary), and returns its result in the one result schema (common/result_file.h).
+// dm_run_scene runs any of them; the soil rigs among them also run in the rig nodelet
+// (scenes/soil_rig.h), the mobility run in the vehicle, terrain and driver nodelets.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "dem_mobility/core/common/result_file.h"
+
+namespace dem_mobility {
+
+class YamlReader;
+
+struct SceneRunOptions {
+  std::string history_file;  ///< mobility runs: the speed history as CSV ("" none)
+  bool quiet = false;        ///< no progress lines
+};
+
+struct SceneKind {
+  std::string scene;  ///< the `scene:` key
+  std::string what;   ///< one line for listings
+  /// Reads the scene (ConfigError for bad input) and runs it. A numerical failure does not throw:
+  /// the result says status error, with what was measured so far.
+  std::function<ResultFile(const YamlReader& scene_file, const SceneRunOptions& options)> run;
+};
+
+const std::vector<SceneKind>& SceneKinds();
+/// The kind of a scene file (its `scene:` key); ConfigError listing the known kinds otherwise.
+const SceneKind& FindSceneKind(const YamlReader& scene_file);
+
+}  // namespace dem_mobility

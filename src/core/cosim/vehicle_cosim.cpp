@@ -1,0 +1,87 @@
+#include "dem_mobility/core/cosim/vehicle_cosim.h"
+
+#include <cmath>
+
+#include "dem_mobility/core/common/error.h"
+
+namespace dem_mobility {
+
+Eigen::Vector3d VehicleCoSim::GradeGravity(double deg) {
+  const double a = deg * M_PI / 180.0;
+  return 9.81 * Eigen::Vector3d(-std::sin(a), 0.0, -std::cos(a));
+}
+
+VehicleCoSim::VehicleCoSim(const MobilityRunParams& p) : p_(p) {
+  // the chassis frame at x = 0 with the tires just touching the plane z = 0
+  vehicle_ = Vehicle::Load(p.vehicle_file, Eigen::Vector3d::Zero());
+  MultibodySystem& sys = vehicle_->system();
+  const Eigen::Vector3d shift(0.0, 0.0, vehicle_->design_ride_height());
+  for (int i = 1; i < sys.num_bodies(); ++i) sys.mutable_body(i).x += shift;
+  sys.set_gravity(GradeGravity(p.grade_deg));
+  states_.resize(kWheels);
+  wrenches_.resize(kWheels);
+}
+
+void VehicleCoSim::Exchange(TerrainPort& terrain) {
+  for (int i = 0; i < kWheels; ++i) states_[i] = vehicle_->GetWheelState(i);
+  // the terrain advances to the next exchange: one coupling interval of vehicle steps
+  terrain.Exchange(step(), time(), dt_ * p_.coupling_interval, states_, &wrenches_);
+  DM_THROW_UNLESS(wrenches_.size() == kWheels, "the terrain answered step ", step(), " with ", wrenches_.size(),
+                  " wrenches for ", kWheels, " wheels");
+  for (int i = 0; i < kWheels; ++i) {
+    const WheelWrench& w = wrenches_[i];
+    if (!(w.force.allFinite() && w.moment.allFinite()))
+      throw SimulationError(detail::Concat("step ", step(), " (t = ", time(), " s): the terrain's wrench on wheel ",
+                                           kWheelNames[i], " is not finite (force ", w.force.transpose(), ")"));
+    vehicle_->SetWheelWrench(i, w);
+  }
+  ++exchanges_;
+  last_exchange_ = step();
+  CheckContactLimit();
+}
+
+void VehicleCoSim::CheckContactLimit() {
+  // the contact the terrain reports must stay within the explicit limit of the step in use
+  const WheelWrench& w0 = wrenches_[0];
+  if (dt_ > 0.0 && (w0.stiffness != checked_stiffness_ || w0.damping != checked_damping_)) {
+    const TimeStepLimit c = vehicle_->WheelContactLimit(w0.stiffness, w0.damping);
+    if (dt_ > c.dt_crit)
+      throw SimulationError(detail::Concat("step ", step(), " (t = ", time(), " s): time step ", dt_,
+                                           " s is above the critical step ", c.dt_crit, " s of ", c.element, " (",
+                                           c.detail, ")"));
+    checked_stiffness_ = w0.stiffness;
+    checked_damping_ = w0.damping;
+  }
+}
+
+void VehicleCoSim::Start(TerrainPort& terrain) {
+  DM_DEMAND(dt_ == 0.0);
+  Exchange(terrain);
+  MultibodySystem& sys = vehicle_->system();
+  limit_ = sys.CriticalTimeStep();
+  const TimeStepLimit contact = vehicle_->WheelContactLimit(wrenches_[0].stiffness, wrenches_[0].damping);
+  if (contact.dt_crit < limit_.dt_crit) limit_ = contact;
+  const double dt = p_.time_step > 0.0 ? p_.time_step : p_.time_step_safety * limit_.dt_crit;
+  if (!(dt <= limit_.dt_crit))
+    throw ConfigError(detail::Concat(p_.file, ": time_step: time step dt = ", dt, " s is above the critical step ",
+                                     limit_.dt_crit, " s of ", limit_.element, " (", limit_.detail, "); use dt <= ",
+                                     limit_.dt_crit, " s or soften that element"));
+  try {
+    sys.Finalize(dt);
+  } catch (const ConfigError& e) {
+    throw ConfigError(p_.file + ": time_step: " + e.what());
+  }
+  dt_ = dt;
+  checked_stiffness_ = wrenches_[0].stiffness;
+  checked_damping_ = wrenches_[0].damping;
+  settle_steps_ = std::lround(p_.settle_time / dt_);
+}
+
+void VehicleCoSim::Step(TerrainPort& terrain) {
+  MultibodySystem& sys = vehicle_->system();
+  sys.BeginStep();
+  if (sys.step_count() % p_.coupling_interval == 0) Exchange(terrain);
+  sys.EndStep();
+}
+
+}  // namespace dem_mobility

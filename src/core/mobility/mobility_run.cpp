@@ -1,0 +1,125 @@
+#include "dem_mobility/core/mobility/mobility_run.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/result_file.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+
+namespace dem_mobility {
+
+MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
+  MobilityRunParams p;
+  p.file = y.file();
+  const std::string scene = y.String("scene");
+  if (scene != "road_slope") y.Fail("scene", "expected 'road_slope', found '" + scene + "'");
+  p.vehicle_file = y.ResolvePath(y.String("vehicle"));
+  p.terrain_file = y.ResolvePath(y.String("terrain"));
+  p.grade_deg = y.DoubleIn("grade_deg", -45.0, 45.0);
+  p.duration = y.DoubleIn("duration", 1e-3, 3600.0);
+  p.settle_time = y.DoubleIn("settle_time", 0.0, 10.0, 0.5);
+  if (y.Has("time_step") && y.String("time_step") != "auto") p.time_step = y.DoubleIn("time_step", 1e-7, 1e-2);
+  p.time_step_safety = y.DoubleIn("time_step_safety", 0.01, 1.0, 0.5);
+  p.coupling_interval = y.Int("coupling_interval", 1);
+  if (p.coupling_interval < 1 || p.coupling_interval > 1000)
+    y.Fail("coupling_interval", "must be a whole number of steps in [1, 1000], found " + std::to_string(p.coupling_interval));
+  p.driver = DriverParams::Read(y.Child("driver"));
+  const YamlReader res = y.Child("result");
+  p.sample_rate = res.DoubleIn("sample_rate", 1.0, 1e5, 100.0);
+  p.plateau.window = res.DoubleIn("plateau_window", 0.5, 60.0, 5.0);
+  p.plateau.tolerance = res.Positive("plateau_tolerance", 0.05);
+  p.plateau.stall_speed = res.Positive("stall_speed", 0.2);
+  p.plateau.stall_time = res.Positive("stall_time", 5.0);
+  res.Finish();
+  y.Finish();
+  return p;
+}
+
+SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const PlateauParams& p, double v_max) {
+  SpeedMadeGood s;
+  if (h.empty()) {
+    s.status = "not_steady";
+    return s;
+  }
+  const double t_end = h.back().t;
+  if (t_end >= p.stall_time && h.back().speed < p.stall_speed) {
+    s.status = "no_go";
+    return s;
+  }
+  // least-squares slope and mean over the trailing window
+  double n = 0, st = 0, sv = 0, stt = 0, stv = 0, svv = 0;
+  bool limited = false;
+  for (auto it = h.rbegin(); it != h.rend() && it->t >= t_end - p.window; ++it) {
+    n += 1;
+    st += it->t;
+    sv += it->speed;
+    stt += it->t * it->t;
+    stv += it->t * it->speed;
+    svv += it->speed * it->speed;
+    limited = limited || it->wot_limited;
+  }
+  const double mean = sv / n;
+  const double var_t = stt / n - (st / n) * (st / n);
+  s.window_slope = var_t > 0 ? (stv / n - (st / n) * mean) / var_t : 0.0;
+  s.window_std = std::sqrt(std::max(0.0, svv / n - mean * mean));
+  s.value = mean;
+  if (t_end < p.window) {
+    s.status = "not_steady";
+  } else if (std::abs(s.window_slope) > p.tolerance) {
+    s.status = "not_steady";
+  } else if (!limited && mean >= 0.98 * v_max) {
+    s.status = "command_limited";
+  } else {
+    s.status = "steady";
+  }
+  return s;
+}
+
+std::string MobilityRunResult::Status() const {
+  if (!error.empty()) return "error";
+  if (interrupted) return "interrupted";
+  return smg.status;
+}
+
+ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParams& p,
+                              const std::vector<std::pair<std::string, long>>& published) {
+  ResultFile f(p.file, "road_slope");
+  f.SetStatus(r.Status(), r.error);
+  f.Set("grade_deg", p.grade_deg);
+  f.Set("terrain", p.terrain_file);
+  f.Set("terrain_model", r.terrain_model);
+  f.Set("cone_index_psi", r.cone_index);
+  f.Set("speed_made_good", r.smg.value);
+  f.Set("speed_made_good_mph", r.smg.value / 0.44704);
+  f.Set("verdict", r.smg.status);
+  f.Set("window_slope", r.smg.window_slope);
+  f.Set("window_speed_std", r.smg.window_std);
+  f.Set("ended_early", r.ended_early);
+  f.Set("time_step", r.dt);
+  f.Set("critical_time_step", r.dt_crit);
+  f.Set("critical_element", r.dt_limit_element);
+  f.Set("coupling_interval", p.coupling_interval);
+  f.Set("steps", r.steps);
+  f.Set("exchanges", r.exchanges);
+  f.Set("driver_updates", r.driver_updates);
+  f.Set("simulated_time", r.sim_time);
+  f.Set("wall_time", r.wall_time);
+  f.Set("real_time_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0);
+  f.Set("interrupted", r.interrupted);
+  if (!published.empty()) f.SetCounts("published", published);
+  return f;
+}
+
+void WriteMobilityHistory(const MobilityRunResult& r, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw ConfigError(path + ": cannot write the history file");
+  out << "t,x,speed,speed_command,drive_shaft_speed,drive_torque,brake_effort,wot_limited\n";
+  out << std::setprecision(8);
+  for (const auto& s : r.history)
+    out << s.t << "," << s.x << "," << s.speed << "," << s.speed_command << "," << s.drive_shaft_speed << ","
+        << s.drive_torque << "," << s.brake_effort << "," << s.wot_limited << "\n";
+}
+
+}  // namespace dem_mobility

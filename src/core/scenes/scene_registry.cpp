@@ -1,0 +1,146 @@
+// The scene kinds and how each runs from the command line (dm_run_scene).
+#include "dem_mobility/core/scenes/scene_registry.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/mobility/mobility_scene.h"
+#include "dem_mobility/core/scenes/cone_penetrometer.h"
+#include "dem_mobility/core/scenes/dem_pour.h"
+#include "dem_mobility/core/scenes/uniaxial_compression.h"
+
+namespace dem_mobility {
+namespace {
+
+/// Prints a progress line at most every `period` seconds of wall time.
+class Ticker {
+ public:
+  explicit Ticker(double period) : period_(period) {}
+  bool Due() {
+    const double wall = Elapsed();
+    if (wall < next_) return false;
+    next_ = wall + period_;
+    return true;
+  }
+  double Elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+
+ private:
+  double period_, next_ = 0.0;
+  std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+};
+
+ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) {
+  const MobilityRunParams p = MobilityRunParams::Read(reader);
+  MobilityRun run(p);
+  const TimeStepLimit& lim = run.sim().limit();
+  std::printf("scene %s: grade %.1f deg, %d bodies, dt %.3g s (critical %.3g s, %s), %.1f s simulated\n",
+              p.file.c_str(), p.grade_deg, run.vehicle().system().num_bodies() - 1, run.dt(), lim.dt_crit,
+              lim.element.c_str(), p.duration);
+  std::fflush(stdout);
+  // progress on the console about once a second of wall time
+  class Progress final : public CoSimObserver {
+   public:
+    explicit Progress(double duration) : duration_(duration) {}
+    void OnStep(const VehicleCoSim& sim, const DriveCommand&) override {
+      if ((sim.step() & 255) != 0 || !ticker_.Due()) return;
+      const double t = std::max(0.0, sim.driver_time()), rtf = sim.time() / std::max(ticker_.Elapsed(), 1e-9);
+      std::printf("  t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s\n", t, duration_,
+                  sim.vehicle().ForwardSpeed(), rtf, (duration_ - t) / std::max(rtf, 1e-9));
+      std::fflush(stdout);
+    }
+
+   private:
+    double duration_;
+    Ticker ticker_{1.0};
+  } progress(p.duration);
+  const MobilityRunResult r = run.Run(o.quiet ? nullptr : &progress);
+  if (!o.history_file.empty()) WriteMobilityHistory(r, o.history_file);
+  std::printf("speed_made_good: %.3f m/s (%.2f mph), status %s, window slope %.4f m/s^2\n", r.smg.value,
+              r.smg.value / 0.44704, r.smg.status.c_str(), r.smg.window_slope);
+  std::printf("run: %ld steps, %.2f s simulated in %.2f s wall (real-time factor %.2f)\n", r.steps, r.sim_time,
+              r.wall_time, r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0);
+  return MobilityResultFile(r, p);
+}
+
+ResultFile RunPourScene(const YamlReader& reader, const SceneRunOptions&) {
+  const DemPourParams p = DemPourParams::Read(reader);
+  std::printf("scene %s: %d particles of %.3g m in a %.3g x %.3g m box, dt %.3g s, %d thread(s)\n", p.file.c_str(),
+              p.particles, p.soil.diameter, p.box_length, p.box_width, p.time_step, p.threads);
+  std::fflush(stdout);
+  const DemPourResult r = RunDemPour(p);
+  std::printf("poured: height %.4f m, bulk density %.1f kg/m^3\n", r.height_poured, r.density_poured);
+  std::printf("lid: %.1f kPa held; released: height %.4f m, bulk density %.1f kg/m^3, mean plastic strain %.4f\n",
+              r.lid_pressure_reached * 1e-3, r.height_consolidated, r.density_consolidated, r.mean_plastic_strain);
+  std::printf("run: %ld steps, %.3f s simulated in %.1f s wall (%.2f M particle-steps/s)\n", r.steps, r.sim_time,
+              r.wall_time, r.wall_time > 0 ? 1e-6 * r.particles * r.steps / r.wall_time : 0.0);
+  return DemPourResultFile(r, p);
+}
+
+ResultFile RunConeScene(const YamlReader& reader, const SceneRunOptions& o) {
+  const ConeParams p = ConeParams::Read(reader);
+  std::printf("scene %s: level '%s', f %.4g, mu %.3g, %d particles of %.3g m in a %.3g m container, cone at %.3g m/s, "
+              "dt %.3g s, %d thread(s)\n",
+              p.file.c_str(), p.level.name.c_str(), p.cohesion_factor, p.friction, p.ParticleCount(),
+              p.level.particle_diameter, p.level.container_diameter, p.level.cone_speed, p.level.time_step, p.threads);
+  std::fflush(stdout);
+  ConePenetrometer rig(p);
+  Ticker ticker(2.0);
+  const ConeResult r = rig.Run(
+      [&](const ConePenetrometer& c) {
+        if (o.quiet || !ticker.Due()) return;
+        std::printf("  %7.1f s wall  %s\n", ticker.Elapsed(), c.StatusLine().c_str());
+        std::fflush(stdout);
+      },
+      500);
+  std::printf("prepared: surface %.3f m, bulk density %.1f -> %.1f kg/m^3, lid %.1f kPa held\n", r.surface_height,
+              r.density_poured, r.density_consolidated, r.lid_pressure_reached * 1e-3);
+  std::printf("cone_index: %.2f psi (std %.2f, trend %.1f psi/m over tip depths %.3g-%.3g m, %d samples); cone speed "
+              "%.4f-%.4f m/s\n",
+              r.ci_psi, r.ci_std_psi, r.ci_trend_psi_per_m, p.level.ci_from, p.level.ci_to, r.window_samples,
+              r.speed_min, r.speed_max);
+  std::printf("run: %ld steps, %.3f s simulated (%.3f s preparation) in %.1f s wall\n", r.steps, r.sim_time,
+              r.prep_time, r.wall_time);
+  return ConeResultFile(r, p);
+}
+
+ResultFile RunCompressionScene(const YamlReader& reader, const SceneRunOptions&) {
+  const CompressionParams p = CompressionParams::Read(reader);
+  std::printf("scene %s: %.3g m particles in a %.3g m cylinder, f %.3g, dt %.3g s\n", p.file.c_str(),
+              p.particle_diameter, p.cylinder_diameter, p.soil.cohesion_factor, p.time_step);
+  std::fflush(stdout);
+  const CompressionResult r = RunUniaxialCompression(p);
+  std::printf("poured: %.1f kg/m^3 (%d particles)\n", r.density_poured, r.particles);
+  for (const CompressionPoint& c : r.loading)
+    std::printf("  loading   %8.1f kPa  %7.1f kg/m^3\n", c.pressure * 1e-3, c.density);
+  for (const CompressionPoint& c : r.unloading)
+    std::printf("  unloading %8.1f kPa  %7.1f kg/m^3\n", c.pressure * 1e-3, c.density);
+  std::printf("released: %.1f kg/m^3; %.3f s simulated in %.1f s wall\n", r.density_released, r.sim_time, r.wall_time);
+  return CompressionResultFile(r, p);
+}
+
+}  // namespace
+
+const std::vector<SceneKind>& SceneKinds() {
+  static const std::vector<SceneKind> kinds = {
+      {"road_slope", "the vehicle accelerating up a grade on a terrain: speed-made-good", &RunMobilityScene},
+      {"dem_pour", "soil preparation: pour, settle, consolidate with a lid, release", &RunPourScene},
+      {"cone_penetrometer", "the cone penetrometer: cone index of a prepared soil", &RunConeScene},
+      {"uniaxial_compression", "piston-cylinder compression: bulk density against pressure", &RunCompressionScene},
+  };
+  return kinds;
+}
+
+const SceneKind& FindSceneKind(const YamlReader& y) {
+  const std::string kind = y.String("scene");
+  std::string known;
+  for (const SceneKind& k : SceneKinds()) {
+    if (k.scene == kind) return k;
+    known += (known.empty() ? "" : ", ") + k.scene;
+  }
+  y.Fail("scene", "unknown scene '" + kind + "' (known: " + known + ")");
+}
+
+}  // namespace dem_mobility

@@ -1,0 +1,44 @@
+#include "dem_mobility/core/scenes/soil_rig.h"
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/scenes/cone_penetrometer.h"
+
+namespace dem_mobility {
+
+void RunSoilRig(SoilRig& rig, const std::function<void(const SoilRig&)>& progress, long every) {
+  try {
+    while (!rig.done()) {
+      rig.Step();
+      if (progress && rig.dem().step_count() % every == 0) progress(rig);
+    }
+  } catch (const SimulationError& e) {
+    rig.Fail(e.what());
+  }
+}
+
+const std::vector<SoilRigKind>& SoilRigKinds() {
+  static const std::vector<SoilRigKind> kinds = {
+      {"cone_penetrometer",
+       [](const YamlReader& y) { return std::make_unique<ConePenetrometer>(ConeParams::Read(y)); }},
+  };
+  return kinds;
+}
+
+bool IsSoilRigScene(const std::string& kind) {
+  for (const SoilRigKind& k : SoilRigKinds())
+    if (k.scene == kind) return true;
+  return false;
+}
+
+std::unique_ptr<SoilRig> MakeSoilRig(const YamlReader& y) {
+  const std::string kind = y.String("scene");
+  std::string known;
+  for (const SoilRigKind& k : SoilRigKinds()) {
+    if (k.scene == kind) return k.make(y);
+    known += (known.empty() ? "" : ", ") + k.scene;
+  }
+  y.Fail("scene", "'" + kind + "' is not a soil rig (rigs: " + known + ")");
+}
+
+}  // namespace dem_mobility

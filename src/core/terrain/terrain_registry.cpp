@@ -1,0 +1,41 @@
+// The registry of terrain kinds: one row per `model:` (the next kinds are added here).
+#include <memory>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/terrain/road_terrain.h"
+#include "dem_mobility/core/terrain/terrain_model.h"
+
+namespace dem_mobility {
+
+const std::vector<TerrainKind>& TerrainKinds() {
+  static const std::vector<TerrainKind> kinds = {
+      {"rigid_road", "a rigid polygonal road (tire vertices against its triangles, asperity friction)",
+       [](const YamlReader& y, const TerrainVehicle& v) { return MakeRoadTerrain(y, v); }, &DescribeRoadTerrain},
+  };
+  return kinds;
+}
+
+namespace {
+const TerrainKind& FindKind(const YamlReader& y) {
+  const std::string model = y.String("model");
+  std::string known;
+  for (const TerrainKind& k : TerrainKinds()) {
+    if (k.model == model) return k;
+    known += (known.empty() ? "" : ", ") + k.model;
+  }
+  y.Fail("model", "unknown terrain model '" + model + "' (known: " + known + ")");
+}
+}  // namespace
+
+std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle) {
+  const YamlReader y = YamlReader::Load(terrain_file);
+  return FindKind(y).make(y, vehicle);
+}
+
+TerrainDescription DescribeTerrain(const std::string& terrain_file) {
+  const YamlReader y = YamlReader::Load(terrain_file);
+  return FindKind(y).describe(y);
+}
+
+}  // namespace dem_mobility
