@@ -195,12 +195,13 @@ class Pool(Base):
         self.assertIn('value 2.0', self.out.getvalue())
 
     def test_parallelism(self):
-        for jobs in (1, 3):
+        # each run lasts well beyond the start-up of a python process on a loaded machine
+        for jobs, n, sleep in ((1, 3, 0.3), (3, 6, 1.0)):
             with self.subTest(jobs=jobs):
                 if os.path.exists(self.journal):
                     os.remove(self.journal)
-                cases = dm_sweep.grid([('x', list(range(6)))])
-                s = self.sweep(cases, jobs=jobs, command=self.command(sleep=0.5))
+                cases = dm_sweep.grid([('x', list(range(n)))])
+                s = self.sweep(cases, jobs=jobs, command=self.command(sleep=sleep))
                 s.run()
                 self.assertEqual(s.exit_status(), 0)
                 events = sorted((t, w, n, p) for w, n, t, p in self.journal_rows())
