@@ -18,13 +18,16 @@ A failed run is reported and the others are kept; the exit status is 1 if any ru
 import argparse
 import math
 import os
-import re
 import shutil
 import subprocess
 import sys
 import time
 
 import yaml
+
+# dm_sweep lives beside this script (also when run through catkin's relay in devel/lib)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import dm_sweep  # noqa: E402
 
 PAPER_TABLE = [(30, 0.06), (40, 0.15), (50, 0.5), (60, 0.84), (70, 1.18), (80, 1.52), (100, 2.24),
                (120, 3.03), (150, 4.46), (200, 7.85), (242, 12.1)]
@@ -42,69 +45,21 @@ def case_name(mu, f):
     return 'mu%g_f%g' % (mu, f)
 
 
+def bag_path(out, name):
+    return os.path.join(out, 'runs', name + '.bag')
+
+
 class Run:
-    def __init__(self, mu, f, out, port):
-        self.mu, self.f = mu, f
-        self.name = case_name(mu, f)
-        self.bag = os.path.join(out, 'runs', self.name + '.bag')
-        self.result_file = self.bag[:-4] + '.result.yaml'
-        self.log = self.bag[:-4] + '.log'
-        self.port = port
-        self.proc = None
-        self.start = self.end = None
-        self.result = None
-        self.error = None
+    """A run's outcome (dm_sweep.Outcome) as the fit, the tables and the plots see it."""
 
-    def launch(self, a):
-        for p in (self.bag, self.result_file):
-            if os.path.exists(p):
-                os.remove(p)
-        env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % self.port, PYTHONUNBUFFERED='1',
-                   ROSCONSOLE_STDOUT_LINE_BUFFERED='1')
-        cmd = ['roslaunch', '-p', str(self.port), 'dem_mobility', 'cone_penetrometer.launch',
-               'scene:=' + os.path.abspath(a.scene), 'fidelity:=' + a.fidelity, 'f:=%g' % self.f,
-               'mu:=%g' % self.mu, 'dem_threads:=%d' % a.dem_threads, 'bag:=' + os.path.abspath(self.bag),
-               'cloud_rate:=%g' % a.cloud_rate]
-        self.logf = open(self.log, 'w')
-        self.proc = subprocess.Popen(cmd, stdout=self.logf, stderr=subprocess.STDOUT, env=env,
-                                     start_new_session=True)
-        self.start = time.time()
-
-    def progress(self):
-        """The run's last progress line ('terrain: t = ...')."""
-        try:
-            with open(self.log, 'rb') as fh:
-                fh.seek(0, 2)
-                fh.seek(max(0, fh.tell() - 4000))
-                lines = fh.read().decode('utf-8', 'replace').splitlines()
-        except OSError:
-            return ''
-        for line in reversed(lines):
-            k = line.find('progress:')
-            if k >= 0:
-                return re.sub(r'\x1b\[[0-9;]*m', '', line[k + 9:]).strip()
-        return 'starting'
-
-    def finish(self, timeout_hit=False):
-        self.end = time.time()
-        self.logf.close()
-        if timeout_hit:
-            self.error = 'timed out after %.0f s' % (self.end - self.start)
-        try:
-            with open(self.result_file) as fh:
-                self.result = yaml.safe_load(fh)
-        except (OSError, yaml.YAMLError) as e:
-            self.result = None
-            if not self.error:
-                self.error = 'no result file (%s); see %s' % (e, self.log)
-        if self.result is not None and not self.error:
-            err = self.result.get('error') or ''
-            if err or self.result.get('status') == 'error':
-                self.error = err or 'the run failed; see %s' % self.log
-            elif not self.result.get('window_samples'):
-                self.error = 'no CI sample in the window; see %s' % self.log
-        if not self.error and self.proc.returncode not in (0, None):
-            self.error = 'roslaunch exited with %d; see %s' % (self.proc.returncode, self.log)
+    def __init__(self, outcome, out):
+        self.outcome = outcome
+        self.mu, self.f = outcome.case['mu'], outcome.case['f']
+        self.name = outcome.name
+        self.bag = bag_path(out, self.name)
+        self.result_file, self.log = outcome.result_file, outcome.log
+        self.result, self.error = outcome.result, outcome.error
+        self.start, self.end = outcome.start, outcome.end
 
     def ok(self):
         return self.error is None
@@ -233,57 +188,44 @@ def main():
         sys.exit('calibrate_cone_index: ROS does not know the package dem_mobility: '
                  'source the catkin workspace (devel/setup.bash) that built it first')
     os.makedirs(os.path.join(a.out, 'runs'), exist_ok=True)
-    runs = [Run(mu, f, a.out, 0) for mu in a.mu for f in a.f]
-    pending, running, done = list(runs), [], []
-    if a.resume:
-        for r in runs:
-            try:
-                with open(r.result_file) as fh:
-                    old = yaml.safe_load(fh)
-            except (OSError, yaml.YAMLError):
-                continue
-            if (old and not old.get('error') and old.get('fidelity') == a.fidelity and old.get('window_samples')
-                    and abs(old.get('cohesion_factor', -1) - r.f) < 1e-12 and abs(old.get('friction', -1) - r.mu) < 1e-12):
-                r.result, r.start, r.end = old, 0.0, float(old.get('wall_time', 0.0))
-                pending.remove(r)
-                done.append(r)
-                print('kept   %-14s CI %.1f psi (from %s)' % (r.name, r.ci(), r.result_file), flush=True)
-    free_ports = [a.port + 2 * k for k in range(a.jobs)]
-    t0 = time.time()
-    last_status = 0.0
-    print('sweep: %d runs (f %s x mu %s), level %s, %d at a time' %
-          (len(runs), ','.join('%g' % f for f in a.f), ','.join('%g' % m for m in a.mu), a.fidelity, a.jobs), flush=True)
     try:
-        while pending or running:
-            while pending and len(running) < a.jobs:
-                r = pending.pop(0)
-                r.port = free_ports.pop(0)
-                r.launch(a)
-                running.append(r)
-                print('[%6.0f s] start  %-14s (port %d)' % (time.time() - t0, r.name, r.port), flush=True)
-            time.sleep(1.0)
-            for r in list(running):
-                late = time.time() - r.start > a.timeout
-                if r.proc.poll() is None and not late:
-                    continue
-                if late and r.proc.poll() is None:
-                    os.killpg(r.proc.pid, 15)
-                    r.proc.wait()
-                r.finish(timeout_hit=late)
-                running.remove(r)
-                free_ports.append(r.port)
-                done.append(r)
-                what = 'CI %.1f psi' % r.ci() if r.ok() else 'FAILED: ' + r.error
-                print('[%6.0f s] done   %-14s %s (%.0f s)  [%d/%d]' %
-                      (time.time() - t0, r.name, what, r.end - r.start, len(done), len(runs)), flush=True)
-            if running and time.time() - last_status > 20.0:
-                last_status = time.time()
-                for r in running:
-                    print('           ...    %-14s %s' % (r.name, r.progress()), flush=True)
+        cases = dm_sweep.grid([('mu', a.mu), ('f', a.f)], name=lambda p: case_name(p['mu'], p['f']))
+    except ValueError as e:
+        sys.exit('calibrate_cone_index: %s' % e)
+
+    def command(case, run):
+        return ['roslaunch', '-p', str(run.port), 'dem_mobility', 'cone_penetrometer.launch',
+                'scene:=' + os.path.abspath(a.scene), 'fidelity:=' + a.fidelity, 'f:=%g' % case['f'],
+                'mu:=%g' % case['mu'], 'dem_threads:=%d' % a.dem_threads,
+                'bag:=' + os.path.abspath(bag_path(a.out, case.name)), 'cloud_rate:=%g' % a.cloud_rate]
+
+    def check(case, result):
+        return None if result.get('window_samples') else 'no CI sample in the window'
+
+    def describe(run):
+        return 'CI %.1f psi' % float(run.result['cone_index_psi']) if run.ok else 'FAILED: ' + run.error
+
+    def same_run(case, old):
+        """A kept run was made with the same level, f and mu."""
+        try:
+            return (old.get('fidelity') == a.fidelity and abs(old.get('cohesion_factor', -1) - case['f']) < 1e-12
+                    and abs(old.get('friction', -1) - case['mu']) < 1e-12)
+        except TypeError:
+            return False
+
+    sweep = dm_sweep.Sweep(cases, command, os.path.join(a.out, 'runs'), jobs=a.jobs, port=a.port,
+                           timeout=a.timeout, check=check, outputs=lambda case: [bag_path(a.out, case.name)],
+                           describe=describe, poll=1.0, status_every=20.0)
+    if a.resume:
+        sweep.resume(accept=same_run)
+    t0 = time.time()
+    print('sweep: %d runs (f %s x mu %s), level %s, %d at a time' %
+          (len(cases), ','.join('%g' % f for f in a.f), ','.join('%g' % m for m in a.mu), a.fidelity, a.jobs), flush=True)
+    try:
+        sweep.run(t0)
     except KeyboardInterrupt:
-        for r in running:
-            os.killpg(r.proc.pid, 15)
         sys.exit('calibrate_cone_index: interrupted; finished runs are in %s' % a.out)
+    runs = [Run(o, a.out) for o in sweep.outcomes]
     fits = {}
     for mu in a.mu:
         pts = sorted((r.f, r.ci()) for r in runs if r.mu == mu and r.ok())

@@ -12,7 +12,7 @@ DM_CORE_PACKAGES=(cmake g++ make libeigen3-dev libyaml-cpp-dev libgtest-dev libb
 DM_ROS_PACKAGES=(catkin ros-core-dev libroscpp-dev libnodeletlib-dev librosbag-dev libtf2-ros-dev
   libtf2-eigen-dev libnodeletlib-tools ros-geometry-msgs ros-sensor-msgs ros-visualization-msgs ros-message-generation
   ros-nav-msgs ros-rosgraph-msgs ros-tf2-msgs libtopic-tools-dev pluginlib-dev
-  python3-rosbag python3-roslaunch python3-rostest python3-catkin-pkg python3-std-msgs python3-geometry-msgs python3-nodelet python3-matplotlib python3-numpy python3-yaml)
+  python3-rosbag python3-roslaunch python3-rostest python3-catkin-pkg python3-std-msgs python3-geometry-msgs python3-nodelet python3-matplotlib python3-numpy python3-yaml python3-tqdm)
 # only for the checks of the test command (package lint, rviz screenshot under Xvfb)
 DM_CHECK_PACKAGES=(catkin-lint rviz xvfb imagemagick)
 # only for the dem_step benchmark (the side-by-side LAMMPS run)

@@ -1,0 +1,127 @@
+"""scripts/calibrate_cone_index.py without ROS: stand-in `roslaunch` and `rospack` commands on PATH
+write the result files a cone run would; the sweep's lines, files and exit status are those the
+end-to-end test (test/ros/test_cone_sweep.py) checks, and --resume keeps the good runs.
+
+    python3 -m unittest discover -s test/python -v      (from the repository root)
+"""
+import os
+import shutil
+import stat
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+try:
+    import matplotlib  # noqa: F401
+    import numpy  # noqa: F401
+    HAVE_PLOTS = True
+except ImportError:
+    HAVE_PLOTS = False
+
+ROSLAUNCH = r'''#!%s
+import os, sys, time, yaml
+args = dict(a.split(':=', 1) for a in sys.argv[1:] if ':=' in a)
+f, mu, bag = float(args['f']), float(args['mu']), args['bag']
+assert sys.argv[1] == '-p' and os.environ['ROS_MASTER_URI'].endswith(':' + sys.argv[2])
+with open(os.path.join(os.path.dirname(bag), 'calls'), 'a') as fh:
+    fh.write('%%g %%g %%s\n' %% (f, mu, sys.argv[2]))
+print('[ INFO] terrain: progress: t = 0.1 s', flush=True)
+time.sleep(0.2)
+res = bag[:-4] + '.result.yaml'
+if f > 15:
+    with open(res, 'w') as fh:
+        yaml.safe_dump({'status': 'error', 'error': 'parameter cohesion_factor: %%g is out of range' %% f}, fh)
+    sys.exit(1)
+ci = 30 + 20 * f
+open(bag, 'w').write('bag')
+with open(res, 'w') as fh:
+    yaml.safe_dump({'fidelity': args['fidelity'], 'cohesion_factor': f, 'friction': mu, 'cone_index_psi': ci,
+                    'window_samples': 4, 'wall_time': 1.5, 'error': '',
+                    'history': {'t': [0.0, 0.5, 1.0], 'ci_psi': [0.0, ci / 2, ci]}}, fh)
+''' % sys.executable
+
+
+@unittest.skipUnless(HAVE_PLOTS, 'needs python3-numpy and python3-matplotlib')
+class CalibrationSweepWithoutRos(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.mkdtemp(prefix='dm_calibrate_test_')
+        bin_dir = os.path.join(cls.tmp, 'bin')
+        os.makedirs(bin_dir)
+        for name, text in (('roslaunch', ROSLAUNCH), ('rospack', '#!/bin/sh\necho /stand-in/dem_mobility\n')):
+            p = os.path.join(bin_dir, name)
+            with open(p, 'w') as fh:
+                fh.write(text)
+            os.chmod(p, os.stat(p).st_mode | stat.S_IXUSR)
+        cls.env = dict(os.environ, PATH=bin_dir + os.pathsep + os.environ.get('PATH', ''), MPLBACKEND='Agg')
+        cls.out = os.path.join(cls.tmp, 'out')
+        cls.first = cls.sweep('0.5,8,20')
+        with open(os.path.join(cls.out, 'sweep.yaml')) as fh:
+            cls.first_summary = yaml.safe_load(fh)
+        os.remove(os.path.join(cls.out, 'runs', 'calls'))
+        cls.second = cls.sweep('0.5,8,20,3', '--resume')
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, True)
+
+    @classmethod
+    def sweep(cls, f, *more):
+        return subprocess.run(
+            [sys.executable, os.path.join(ROOT, 'scripts', 'calibrate_cone_index.py'), '--fidelity', 'tiny',
+             '--f', f, '--mu', '0.1', '--jobs', '2', '--cloud-rate', '10', '--port', '11711', '--out', cls.out]
+            + list(more), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
+            env=cls.env, timeout=300)
+
+    def test_failed_run_reported_rest_kept(self):
+        self.assertEqual(self.first.returncode, 1, self.first.stdout)
+        self.assertIn('FAILED', self.first.stdout)
+        self.assertIn('sweep: 3 runs (f 0.5,8,20 x mu 0.1), level tiny, 2 at a time\n', self.first.stdout)
+        self.assertRegex(self.first.stdout, r'\[ +\d+ s\] done   mu0.1_f8       CI 190.0 psi \(\d+ s\)  \[\d/3\]')
+        self.assertIn('  failed: mu0.1_f20: parameter cohesion_factor: 20 is out of range', self.first.stdout)
+        sweep = self.first_summary
+        self.assertEqual(list(sweep), ['fidelity', 'wall_time', 'jobs', 'runs'])
+        self.assertEqual((sweep['fidelity'], sweep['jobs']), ('tiny', 2))
+        runs = {r['f']: r for r in sweep['runs']}
+        self.assertEqual(list(runs[0.5]), ['f', 'mu', 'ok', 'cone_index_psi', 'wall_time', 'error', 'bag'])
+        self.assertFalse(runs[20.0]['ok'])
+        self.assertIsNone(runs[20.0]['cone_index_psi'])
+        self.assertIn('cohesion_factor', runs[20.0]['error'])
+        self.assertTrue(runs[0.5]['ok'] and runs[8.0]['ok'])
+        self.assertGreater(runs[8.0]['cone_index_psi'], runs[0.5]['cone_index_psi'])
+        self.assertEqual(runs[0.5]['bag'], os.path.join(self.out, 'runs', 'mu0.1_f0.5.bag'))
+
+    def test_table_and_plots(self):
+        with open(os.path.join(self.out, 'cone_index_mu0.1.yaml')) as fh:
+            cal = yaml.safe_load(fh)
+        self.assertEqual(cal['fidelity'], 'tiny')
+        self.assertEqual(len(cal['cubic']), 4)
+        self.assertEqual(cal['runs'], [[0.5, 40.0], [3.0, 90.0], [8.0, 190.0]])
+        for name in ('ci_vs_time_mu0.1.png', 'ci_vs_f.png'):
+            with open(os.path.join(self.out, name), 'rb') as fh:
+                self.assertEqual(fh.read(8), b'\x89PNG\r\n\x1a\n', name)
+
+    def test_resume_keeps_good_runs(self):
+        out = self.second.stdout
+        self.assertEqual(self.second.returncode, 1, out)
+        self.assertIn('kept   mu0.1_f0.5     CI 40.0 psi (from %s)' % os.path.join(self.out, 'runs', 'mu0.1_f0.5.result.yaml'), out)
+        self.assertIn('kept   mu0.1_f8       CI 190.0 psi', out)
+        with open(os.path.join(self.out, 'runs', 'calls')) as fh:
+            calls = [line.split() for line in fh]
+        self.assertEqual(sorted(c[0] for c in calls), ['20', '3'])
+        self.assertEqual(sorted(c[2] for c in calls), ['11711', '11713'])
+        self.assertRegex(out, r'\[4/4\]')
+        with open(os.path.join(self.out, 'sweep.yaml')) as fh:
+            runs = {r['f']: r for r in yaml.safe_load(fh)['runs']}
+        self.assertEqual(runs[0.5]['wall_time'], 1.5)  # a kept run's own wall time
+        self.assertTrue(runs[3.0]['ok'])
+        self.assertFalse(runs[20.0]['ok'])
+
+
+if __name__ == '__main__':
+    unittest.main()
