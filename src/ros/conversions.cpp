@@ -145,7 +145,7 @@ void Flatten(const XmlRpc::XmlRpcValue& v, const std::string& prefix, std::vecto
 }
 }  // namespace
 
-RoadSceneParams LoadScene(const ros::NodeHandle& nh) { return RoadSceneParams::Read(LoadSceneFile(nh)); }
+MobilityRunParams LoadScene(const ros::NodeHandle& nh) { return MobilityRunParams::Read(LoadSceneFile(nh)); }
 
 YamlReader LoadSceneFile(const ros::NodeHandle& nh) {
   std::string file;

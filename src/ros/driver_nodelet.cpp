@@ -4,6 +4,8 @@
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 
+#include "dem_mobility/core/cosim/ports.h"
+#include "dem_mobility/core/vehicle/vehicle.h"
 #include "dem_mobility/ros/conversions.h"
 
 namespace dem_mobility {
@@ -22,7 +24,7 @@ class DriverNodelet : public nodelet::Nodelet {
     std::string transport;
     std::unique_ptr<ExchangeServer<DriverInput, DriverCommand>> server;
     try {
-      const RoadSceneParams scene = LoadScene(nh);
+      const MobilityRunParams scene = LoadScene(nh);
       const ExchangeTiming timing = LoadExchangeTiming(pnh, &transport);
       driver_ = std::make_unique<SceneDriver>(scene.driver, scene.vehicle_file);
       server = std::make_unique<ExchangeServer<DriverInput, DriverCommand>>(

@@ -7,8 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <thread>
 
 #include <nav_msgs/Odometry.h>
@@ -20,6 +18,9 @@
 
 #include "dem_mobility/MobilityResult.h"
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/result_file.h"
+#include "dem_mobility/core/cosim/cosim_loop.h"
+#include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/ros/conversions.h"
 #include "dem_mobility/ros/vehicle_visuals.h"
 
@@ -29,8 +30,10 @@ namespace {
 /// The terrain reached through the lock-step exchange.
 class ExchangeTerrainPort final : public TerrainPort {
  public:
-  ExchangeTerrainPort(std::unique_ptr<ExchangeClient<WheelStates, WheelWrenches>> client, std::string frame)
-      : client_(std::move(client)), frame_(std::move(frame)) {}
+  ExchangeTerrainPort(std::unique_ptr<ExchangeClient<WheelStates, WheelWrenches>> client, std::string frame,
+                      TerrainDescription description)
+      : client_(std::move(client)), frame_(std::move(frame)), description_(std::move(description)) {}
+  const TerrainDescription& description() const override { return description_; }
   void Exchange(long step, double t, double dt, const std::vector<WheelState>& states,
                 std::vector<WheelWrench>* wrenches) override {
     auto req = boost::make_shared<WheelStates>();
@@ -54,6 +57,7 @@ class ExchangeTerrainPort final : public TerrainPort {
  private:
   std::unique_ptr<ExchangeClient<WheelStates, WheelWrenches>> client_;
   std::string frame_;
+  TerrainDescription description_;  ///< of the scene's terrain file: the terrain nodelet runs the same
 };
 
 /// The driver reached through the lock-step exchange.
@@ -129,19 +133,13 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       check(force_scale_ > 0.0 && std::isfinite(force_scale_), "force_scale", "must be a positive length per force [m/N]");
       log_rate_ = log_rate;
       clock_rate_ = clock_rate;
-      if (!result_file_.empty()) {
-        const std::filesystem::path parent = std::filesystem::path(result_file_).parent_path();
-        std::error_code ec;
-        if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-        check(static_cast<bool>(std::ofstream(result_file_, std::ios::app)), "result_file",
-              "cannot write '" + result_file_ + "'");
-      }
+      ResultFile::CheckWritable(result_file_, "parameter " + pnh.resolveName("result_file"));
       sim_ = std::make_unique<VehicleCoSim>(scene_);
       terrain_ = std::make_unique<ExchangeTerrainPort>(
           std::make_unique<ExchangeClient<WheelStates, WheelWrenches>>(
               nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches",
               "terrain", timing),
-          world_frame_);
+          world_frame_, DescribeTerrain(scene_.terrain_file));
       driver_ = std::make_unique<ExchangeDriverPort>(std::make_unique<ExchangeClient<DriverInput, DriverCommand>>(
           nh, transport, nh.resolveName("exchange/driver"), "exchange/driver_input", "exchange/driver_command", "driver",
           timing));
@@ -194,7 +192,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   }
 
   void Run() {
-    RoadResult r;
+    MobilityRunResult r;
     try {
       if (wait_for_recorder_) WaitForRecorder();
       PublishStatic();
@@ -276,16 +274,16 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     tf_static_.Publish(m);
   }
 
-  void Finish(const RoadResult& r) {
+  void Finish(const MobilityRunResult& r) {
     MobilityResult m;
     m.header.stamp = ros::Time(sim_ ? sim_->time() : 0.0);
     m.header.frame_id = world_frame_;
     m.scene = scene_.file;
     m.grade_deg = scene_.grade_deg;
-    m.cone_index_psi = 300.0;
-    m.terrain_model = "rigid_road";
+    m.cone_index_psi = r.cone_index;
+    m.terrain_model = r.terrain_model;
     m.speed_made_good = r.smg.value;
-    m.status = !r.error.empty() ? "error" : (r.interrupted ? "interrupted" : r.smg.status);
+    m.status = r.Status();
     m.window_slope = r.smg.window_slope;
     m.time_step = r.dt;
     m.critical_time_step = r.dt_crit;
@@ -305,7 +303,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       std::vector<std::pair<std::string, long>> counts;
       for (const Counted* c : counted_) counts.emplace_back(c->name, c->count);
       try {
-        WriteRoadResult(r, scene_, result_file_, m.status, counts);
+        MobilityResultFile(r, scene_, counts).Write(result_file_);
         NODELET_INFO("result: %s", result_file_.c_str());
       } catch (const std::exception& e) {
         NODELET_ERROR("%s", e.what());
@@ -318,10 +316,10 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   void Fail(const std::string& what) {
     NODELET_FATAL("%s", what.c_str());
     if (!result_file_.empty()) {
-      RoadResult r;
-      r.error = what;
+      ResultFile r(scene_.file, "road_slope");
+      r.SetStatus("error", what);
       try {
-        WriteRoadResult(r, scene_, result_file_, "error", {});
+        r.Write(result_file_);
       } catch (const std::exception& e) {
         NODELET_ERROR("%s", e.what());
       }
@@ -329,7 +327,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     ros::requestShutdown();
   }
 
-  RoadSceneParams scene_;
+  MobilityRunParams scene_;
   std::unique_ptr<VehicleCoSim> sim_;
   std::unique_ptr<ExchangeTerrainPort> terrain_;
   std::unique_ptr<ExchangeDriverPort> driver_;

@@ -13,7 +13,8 @@
 #include "dem_mobility/WheelWrenches.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/cosim/exchange.h"
-#include "dem_mobility/core/scenes/road_scene.h"
+#include "dem_mobility/core/vehicle/driver.h"
+#include "dem_mobility/core/mobility/mobility_run.h"
 #include "dem_mobility/ros/lockstep.h"
 
 namespace dem_mobility {
@@ -31,7 +32,7 @@ DriveCommand FromMsg(const DriverCommand& m);
 /// file) and the overrides under `override/` (e.g. override/grade_deg: 12, override/driver/kp: 4000;
 /// empty strings are unset), applied as dotted key=value overrides. Throws ConfigError naming the
 /// file (or the parameter).
-RoadSceneParams LoadScene(const ros::NodeHandle& nh);
+MobilityRunParams LoadScene(const ros::NodeHandle& nh);
 /// The same scene file with its overrides applied, for any kind of scene.
 YamlReader LoadSceneFile(const ros::NodeHandle& nh);
 /// The exchange settings of a nodelet: `exchange_transport`, `exchange_spin` [s],

@@ -9,7 +9,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "dem_mobility/core/scenes/road_scene.h"
+#include "dem_mobility/core/cosim/vehicle_cosim.h"
 
 namespace dem_mobility {
 

@@ -1,0 +1,210 @@
+// dem_mobility/SoilRigNodelet: a soil rig scene (the cone penetrometer now, the single-wheel rig
+// next: any kind the core's rig registry knows), stepped here on a thread of its own, with the
+// particles as a PointCloud2 (coloured by plastic strain; a cross-section too), the container and
+// the moving walls as markers, the rig's own measurements and result as topics (RigTopics), /clock
+// and the result file. No physics here: the core computes, the nodelet converts and publishes.
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/result_file.h"
+#include "dem_mobility/ros/conversions.h"
+#include "dem_mobility/ros/dem_visuals.h"
+#include "dem_mobility/ros/rig_topics.h"
+
+namespace dem_mobility {
+
+class SoilRigNodelet : public nodelet::Nodelet {
+ public:
+  ~SoilRigNodelet() override {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& pnh = getPrivateNodeHandle();
+    pnh.param<std::string>("frame_id", frame_id_, "map");
+    pnh.param<std::string>("result_file", result_file_, "");
+    pnh.param("cloud_rate", cloud_rate_, cloud_rate_);
+    pnh.param("clock_rate", clock_rate_, clock_rate_);
+    pnh.param("wait_for_recorder", wait_for_recorder_, true);
+    ros::NodeHandle root;
+    clock_ = root.advertise<rosgraph_msgs::Clock>("/clock", 10);
+    markers_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/markers", 1, true);
+    tools_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/tools", 10);
+    cloud_ = nh.advertise<sensor_msgs::PointCloud2>("terrain/particles", 2);
+    section_ = nh.advertise<sensor_msgs::PointCloud2>("terrain/particles_section", 2);
+    std::string kind = "?";
+    try {
+      const YamlReader scene = LoadSceneFile(nh);
+      scene_file_ = scene.file();
+      kind = scene.String("scene");
+      topics_ = MakeRigTopics(kind);
+      topics_->Advertise(nh);
+      if (!(cloud_rate_ > 0.0)) throw ConfigError("parameter " + pnh.resolveName("cloud_rate") + " must be > 0 Hz");
+      if (!(clock_rate_ > 0.0)) throw ConfigError("parameter " + pnh.resolveName("clock_rate") + " must be > 0 Hz");
+      ResultFile::CheckWritable(result_file_, "parameter " + pnh.resolveName("result_file"));
+      rig_ = MakeSoilRig(scene);
+    } catch (const std::exception& e) {
+      NODELET_FATAL("%s", e.what());
+      if (topics_) topics_->PublishSetupError(e.what());
+      if (!result_file_.empty()) {
+        ResultFile f(scene_file_, kind);
+        f.SetStatus("error", e.what());
+        try {
+          f.Write(result_file_);
+        } catch (const std::exception& w) {
+          NODELET_ERROR("%s", w.what());
+        }
+      }
+      ros::requestShutdown();
+      return;
+    }
+    NODELET_INFO("soil rig '%s' from %s: %d particles", rig_->kind(), scene_file_.c_str(), rig_->dem().num_alive());
+    thread_ = std::thread([this] { Run(); });
+  }
+
+  void WaitForRecorder() {
+    // the recorder first: nothing of the run may be lost
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (wait_for_recorder_ && !stop_ && ros::ok() &&
+           (cloud_.getNumSubscribers() == 0 || tools_.getNumSubscribers() == 0 || !topics_->Subscribed())) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        NODELET_WARN("soil rig: no recorder after 60 s; running without");
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
+  void Run() {
+    WaitForRecorder();
+    const DemSystem& s = rig_->dem();
+    const double dt = s.dt();
+    const long cloud_every = std::max(1L, std::lround(1.0 / (cloud_rate_ * dt)));
+    const long clock_every = std::max(1L, std::lround(1.0 / (clock_rate_ * dt)));
+    PublishContainer();
+    PublishFrame();
+    const auto wall0 = std::chrono::steady_clock::now();
+    auto next_progress = wall0 + std::chrono::seconds(10);
+    try {
+      while (!rig_->done()) {
+        if (stop_ || !ros::ok()) {
+          rig_->Fail("interrupted: the run was stopped before its end");
+          break;
+        }
+        rig_->Step();
+        const long k = s.step_count();
+        if ((k & 1023) == 0 && std::chrono::steady_clock::now() > next_progress) {
+          next_progress = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+          NODELET_INFO("progress: %s", rig_->StatusLine().c_str());
+        }
+        if (k % clock_every == 0) {
+          rosgraph_msgs::Clock c;
+          c.clock = ros::Time(s.time());
+          clock_.publish(c);
+        }
+        topics_->PublishProgress(*rig_, frame_id_);
+        if (k % cloud_every == 0 || rig_->done()) PublishFrame();
+      }
+    } catch (const SimulationError& e) {
+      NODELET_ERROR("soil rig: %s", e.what());
+      rig_->Fail(e.what());
+      PublishFrame();
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    const ResultFile result = rig_->Report();
+    if (!result_file_.empty()) {
+      try {
+        result.Write(result_file_);
+        NODELET_INFO("result: %s", result_file_.c_str());
+      } catch (const std::exception& e) {
+        NODELET_ERROR("%s", e.what());
+      }
+    }
+    NODELET_INFO("%s: %.2f s simulated in %.1f s; %s", rig_->StatusLine().c_str(), s.time(), wall,
+                 result.error().empty() ? "ok" : result.error().c_str());
+    topics_->PublishResult(*rig_, ros::Time(s.time() + dt), frame_id_, wall);  // the recorder ends the run on it
+  }
+
+  bool Moving(int w) const {
+    for (int m : rig_->moving_walls())
+      if (m == w) return true;
+    return false;
+  }
+
+  void PublishContainer() {
+    visualization_msgs::MarkerArray arr;
+    const DemSystem& s = rig_->dem();
+    int id = 0;
+    for (int w = 0; w < s.num_walls(); ++w) {
+      if (Moving(w)) continue;
+      // the floor opaque, the sides see-through
+      const bool floor = s.wall(w).name == "floor";
+      visualization_msgs::Marker m = WallMarker(s.wall(w), "container", id++, 0.55f, 0.6f, 0.7f, floor ? 1.0f : 0.25f);
+      m.header.frame_id = frame_id_;
+      arr.markers.push_back(m);
+    }
+    markers_.publish(arr);
+  }
+
+  void PublishFrame() {
+    const DemSystem& s = rig_->dem();
+    const ros::Time stamp(std::max(s.time(), 1e-6));
+    auto cloud = boost::make_shared<sensor_msgs::PointCloud2>();
+    ToPointCloud(s, cloud.get());
+    cloud->header.stamp = stamp;
+    cloud->header.frame_id = frame_id_;
+    cloud_.publish(cloud);
+    // the half y >= 0: a cross-section through the rig's axis, seen from -y (paper fig. 12)
+    auto section = boost::make_shared<sensor_msgs::PointCloud2>();
+    ToPointCloud(s, section.get(), [](const Eigen::Vector3d& x) { return x.y() >= 0.0; });
+    section->header = cloud->header;
+    section_.publish(section);
+    auto arr = boost::make_shared<visualization_msgs::MarkerArray>();
+    auto add = [&](visualization_msgs::Marker m) {
+      m.header.stamp = stamp;
+      m.header.frame_id = frame_id_;
+      arr->markers.push_back(std::move(m));
+    };
+    static const float kColours[][4] = {{0.85f, 0.3f, 0.1f, 1.0f}, {0.7f, 0.7f, 0.7f, 1.0f}, {0.2f, 0.4f, 0.9f, 0.6f}};
+    int id = 0;
+    for (int w : rig_->moving_walls()) {
+      const float* c = kColours[std::min(id, 2)];
+      add(WallMarker(s.wall(w), s.wall(w).name, id++, c[0], c[1], c[2], c[3]));
+    }
+    visualization_msgs::Marker text;
+    text.ns = "status";
+    text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+    text.action = visualization_msgs::Marker::ADD;
+    text.pose.orientation.w = 1.0;
+    text.pose.position.z = -0.25;  // under the container's floor, clear of the tools and the soil
+    text.scale.z = 0.12;
+    text.color.r = text.color.g = text.color.b = text.color.a = 1.0f;
+    text.text = rig_->StatusLine();
+    add(text);
+    tools_.publish(arr);
+  }
+
+  std::unique_ptr<SoilRig> rig_;
+  std::unique_ptr<RigTopics> topics_;
+  std::string scene_file_, frame_id_, result_file_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  ros::Publisher clock_, markers_, tools_, cloud_, section_;
+  double cloud_rate_ = 20.0, clock_rate_ = 100.0;
+  bool wait_for_recorder_ = true;
+};
+
+}  // namespace dem_mobility
+
+PLUGINLIB_EXPORT_CLASS(dem_mobility::SoilRigNodelet, nodelet::Nodelet)
