@@ -43,8 +43,8 @@ class VehicleAssembler {
         rotational_(spec_.rotational_penalty) {}
 
   void Chassis();
-  /// The suspension of one corner: arms, upright, wheel, spring, shock, brake, and the tie rod (steered
-  /// axle) or toe link.
+  /// The suspension of one corner: arms, upright, wheel, spring, shock, brake, and the tie rod
+  /// (steered axle) or toe link.
   void Corner(int axle, int side);
   /// The rack between the front tie rods' inner ends, sliding along y in the chassis.
   void Steering();
@@ -175,8 +175,11 @@ void VehicleAssembler::Corner(int axle, int side) {
   const int chassis = vehicle_->chassis_;
 
   const int upright = Body("upright_" + c, suspension.upright, point(h.upright));
-  const int uca = Body("uca_" + c, suspension.uca, (point(h.uca_front) + point(h.uca_back) + point(h.uca_upright)) / 3.0);
-  const int lca = Body("lca_" + c, suspension.lca, (point(h.lca_front) + point(h.lca_back) + point(h.lca_upright)) / 3.0);
+  // the arms' centres of mass: the centroids of their three hardpoints
+  const int uca =
+      Body("uca_" + c, suspension.uca, (point(h.uca_front) + point(h.uca_back) + point(h.uca_upright)) / 3.0);
+  const int lca =
+      Body("lca_" + c, suspension.lca, (point(h.lca_front) + point(h.lca_back) + point(h.lca_upright)) / 3.0);
   const int wheel = Body("wheel_" + c, suspension.wheel, point(h.spindle));
   vehicle_->wheels_[corner] = wheel;
   spindle_[corner] = point(h.spindle);
@@ -296,7 +299,9 @@ void VehicleAssembler::DriveShaft() {
   const int shaft = Rod("drive_shaft", spec_.driveline.drive_shaft, front, rear);
   Revolute("drive_shaft_bearing", chassis, shaft, 0.5 * (front + rear), Vector3d::UnitX(), 0.4 * (front - rear).norm());
   Coupling("centre_differential", chassis,
-           {{pinion_[0], Vector3d::UnitX(), 1.0}, {pinion_[1], Vector3d::UnitX(), 1.0}, {shaft, Vector3d::UnitX(), -2.0}});
+           {{pinion_[0], Vector3d::UnitX(), 1.0},
+            {pinion_[1], Vector3d::UnitX(), 1.0},
+            {shaft, Vector3d::UnitX(), -2.0}});
   AxisTorque drive;
   drive.name = "drive_torque";
   drive.housing = chassis;
