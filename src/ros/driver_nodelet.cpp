@@ -5,7 +5,7 @@
 #include <pluginlib/class_list_macros.hpp>
 
 #include "dem_mobility/core/cosim/ports.h"
-#include "dem_mobility/core/vehicle/vehicle.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 #include "dem_mobility/ros/conversions.h"
 
 namespace dem_mobility {
@@ -26,7 +26,7 @@ class DriverNodelet : public nodelet::Nodelet {
     try {
       const MobilityRunParams scene = LoadScene(nh);
       const ExchangeTiming timing = LoadExchangeTiming(pnh, &transport);
-      driver_ = std::make_unique<SceneDriver>(scene.driver, scene.vehicle_file);
+      driver_ = std::make_unique<SceneDriver>(scene.driver, VehicleSpec::Load(scene.vehicle_file));
       server = std::make_unique<ExchangeServer<DriverInput, DriverCommand>>(
           nh, transport, nh.resolveName("exchange/driver"), "exchange/driver_input", "exchange/driver_command", timing);
       NODELET_INFO("driver: %.2f m/s^2 toward %.1f m/s, every %.4g s, exchange over %s", scene.driver.accel,

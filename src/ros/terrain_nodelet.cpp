@@ -10,7 +10,7 @@
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
-#include "dem_mobility/core/vehicle/vehicle.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 #include "dem_mobility/ros/conversions.h"
 
 namespace dem_mobility {
@@ -32,7 +32,7 @@ class TerrainNodelet : public nodelet::Nodelet {
       const MobilityRunParams scene = LoadScene(nh);
       const ExchangeTiming timing = LoadExchangeTiming(pnh, &transport);
       pnh.param<std::string>("frame_id", frame_id_, "odom");
-      model_ = LoadTerrainModel(scene.terrain_file, TerrainVehicle{LoadTireGeometry(scene.vehicle_file), kWheels});
+      model_ = LoadTerrainModel(scene.terrain_file, TerrainVehicle{VehicleSpec::Load(scene.vehicle_file).tire, kWheels});
       server = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
           nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches", timing);
       NODELET_INFO("terrain '%s' from %s (%zu triangles), exchange over %s", model_->description().model.c_str(),

@@ -134,7 +134,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       log_rate_ = log_rate;
       clock_rate_ = clock_rate;
       ResultFile::CheckWritable(result_file_, "parameter " + pnh.resolveName("result_file"));
-      sim_ = std::make_unique<VehicleCoSim>(scene_);
+      sim_ = std::make_unique<VehicleCoSim>(scene_, VehicleSpec::Load(scene_.vehicle_file));
       terrain_ = std::make_unique<ExchangeTerrainPort>(
           std::make_unique<ExchangeClient<WheelStates, WheelWrenches>>(
               nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches",

@@ -9,6 +9,7 @@
 
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/vehicle/vehicle.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 namespace dem_mobility {
 namespace {
@@ -37,7 +38,7 @@ class VehicleCopy {
   }
   std::string Error() {
     try {
-      Vehicle::Load((dir_ / "vehicle.yaml").string(), Eigen::Vector3d::Zero());
+      VehicleSpec::Load((dir_ / "vehicle.yaml").string());
     } catch (const ConfigError& e) {
       return e.what();
     }
@@ -51,14 +52,20 @@ class VehicleCopy {
 
 TEST(Config, MissingFile) {
   try {
-    Vehicle::Load("/nonexistent/vehicle.yaml", Eigen::Vector3d::Zero());
+    VehicleSpec::Load("/nonexistent/vehicle.yaml");
     FAIL();
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/vehicle.yaml: cannot open"), std::string::npos) << e.what();
   }
 }
 
-TEST(Config, TheShippedVehicleLoads) { EXPECT_EQ(VehicleCopy().Error(), ""); }
+TEST(Config, TheShippedVehicleLoads) {
+  EXPECT_EQ(VehicleCopy().Error(), "");
+  EXPECT_EQ(Vehicle::Build(VehicleSpec::Load(DM_CONFIG_DIR "/vehicles/hmmwv/vehicle.yaml"), Eigen::Vector3d::Zero())
+                ->system()
+                .num_bodies(),
+            34);
+}
 
 TEST(Config, UnknownKey) {
   VehicleCopy c;
@@ -102,6 +109,28 @@ TEST(Config, WrongTypeNamesTheValue) {
   c.Edit("driveline.yaml", "final_drive_ratio: 0.2", "final_drive_ratio: fast");
   const std::string e = c.Error();
   EXPECT_NE(e.find("driveline.yaml: final_drive_ratio: expected a number, found 'fast'"), std::string::npos) << e;
+}
+
+TEST(Config, WheelbaseDiffersFromTheSuspensions) {
+  VehicleCopy c;
+  c.Edit("vehicle.yaml", "wheelbase: 3.378", "wheelbase: 3.0");
+  const std::string e = c.Error();
+  EXPECT_NE(e.find("vehicle.yaml: wheelbase: wheelbase 3 m differs from the suspensions' x_offset"), std::string::npos)
+      << e;
+}
+
+TEST(Config, SprungMassBelowTheCarriedParts) {
+  VehicleCopy c;
+  c.Edit("vehicle.yaml", "sprung_mass: 4430.0", "sprung_mass: 50.0");
+  const std::string e = c.Error();
+  EXPECT_NE(e.find("vehicle.yaml: chassis.sprung_mass: sprung mass 50 kg is less than the"), std::string::npos) << e;
+}
+
+TEST(Config, HalfShaftWithoutLength) {
+  VehicleCopy c;
+  c.Edit("driveline.yaml", "inner_offset: 0.25", "inner_offset: 0.8");
+  const std::string e = c.Error();
+  EXPECT_NE(e.find("driveline.yaml: half_shaft: inner_offset and outer_inset leave no length"), std::string::npos) << e;
 }
 
 TEST(Config, RunnerExitsNonZeroWithTheMessage) {

@@ -5,6 +5,8 @@
 
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/mobility/mobility_scene.h"
+#include "dem_mobility/core/vehicle/vehicle.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 namespace dem_mobility {
 namespace {
@@ -15,10 +17,39 @@ MobilityRunParams Scene(double grade) {
   return p;
 }
 
+constexpr const char* kHmmwv = DM_CONFIG_DIR "/vehicles/hmmwv/vehicle.yaml";
+
 TEST(Vehicle, HasThePapersThirtyThreeBodies) {
-  MobilityRun s(Scene(0.0));
-  EXPECT_EQ(s.vehicle().system().num_bodies() - 1, 33);  // minus the ground
-  EXPECT_NEAR(s.vehicle().system().TotalMass(), 4430.0 + 4 * (50.0 + 19.45 + 5.81 + 23.97) + 2 * 6.0 + 4 * 6.0, 1e-9);
+  const std::unique_ptr<Vehicle> v = Vehicle::Build(VehicleSpec::Load(kHmmwv), Eigen::Vector3d::Zero());
+  EXPECT_EQ(v->system().num_bodies() - 1, 33);  // minus the ground
+  EXPECT_NEAR(v->system().TotalMass(), 4430.0 + 4 * (50.0 + 19.45 + 5.81 + 23.97) + 2 * 6.0 + 4 * 6.0, 1e-9);
+}
+
+// The driver and the terrain take mass, wheel radius and reduction from the spec alone: they must be
+// those of the built vehicle, the mass to the last bit.
+TEST(VehicleSpec, DerivedFiguresAreTheBuiltVehicles) {
+  const VehicleSpec spec = VehicleSpec::Load(kHmmwv);
+  const std::unique_ptr<Vehicle> v = Vehicle::Build(spec, Eigen::Vector3d(3.0, -1.5, 0.7));
+  EXPECT_EQ(spec.TotalMass(), v->system().TotalMass());
+  EXPECT_EQ(spec.wheel_radius(), v->tire().radius);
+  EXPECT_EQ(spec.driveline_reduction(), v->driveline_reduction());
+  EXPECT_EQ(spec.wheel_radius(), 0.485);
+  EXPECT_EQ(spec.driveline_reduction(), 0.2);
+}
+
+// The total mass is the sprung mass (chassis with the parts it carries) plus the unsprung parts:
+// per corner upright, arms and wheel, the front tie rods and the four half shafts, read here from
+// the files directly.
+TEST(VehicleSpec, TotalMassIsTheSumOfTheFileMasses) {
+  const YamlReader top = YamlReader::Load(kHmmwv);
+  double m = top.Child("chassis").Double("sprung_mass");
+  for (const char* file : {"suspension_front", "suspension_rear"}) {
+    const YamlReader masses = YamlReader::Load(top.ResolvePath(top.String(file))).Child("masses");
+    for (const char* part : {"upright", "uca", "lca", "wheel"}) m += 2.0 * masses.Child(part).Double("mass");
+    if (masses.Has("tierod")) m += 2.0 * masses.Child("tierod").Double("mass");
+  }
+  m += 4.0 * YamlReader::Load(top.ResolvePath(top.String("driveline"))).Child("half_shaft").Double("mass");
+  EXPECT_NEAR(VehicleSpec::Load(kHmmwv).TotalMass(), m, 1e-12 * m);
 }
 
 TEST(Vehicle, AtRestWheelLoadsCarryTheWeightSplitByTheCom) {

@@ -1,7 +1,7 @@
 #include "dem_mobility/core/cosim/ports.h"
 
 #include "dem_mobility/core/terrain/terrain_model.h"
-#include "dem_mobility/core/vehicle/vehicle.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 namespace dem_mobility {
 
@@ -14,12 +14,9 @@ void LocalTerrainPort::Exchange(long step, double t, double dt, const std::vecto
 
 const TerrainDescription& LocalTerrainPort::description() const { return model_.description(); }
 
-SceneDriver::SceneDriver(const DriverParams& p, const std::string& vehicle_file)
-    : vehicle_(Vehicle::Load(vehicle_file, Eigen::Vector3d::Zero())),
-      driver_(p, vehicle_->powertrain(), vehicle_->system().TotalMass(), vehicle_->tire().radius,
-              vehicle_->driveline_reduction()) {}
-
-SceneDriver::~SceneDriver() = default;
+SceneDriver::SceneDriver(const DriverParams& p, const VehicleSpec& vehicle)
+    : powertrain_(vehicle.powertrain),
+      driver_(p, powertrain_, vehicle.TotalMass(), vehicle.wheel_radius(), vehicle.driveline_reduction()) {}
 
 DriveCommand SceneDriver::Exchange(const DriveInput& in) {
   return driver_.Update(in.time, in.period, in.forward_speed, in.drive_shaft_speed);

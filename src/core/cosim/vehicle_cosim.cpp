@@ -11,9 +11,9 @@ Eigen::Vector3d VehicleCoSim::GradeGravity(double deg) {
   return 9.81 * Eigen::Vector3d(-std::sin(a), 0.0, -std::cos(a));
 }
 
-VehicleCoSim::VehicleCoSim(const MobilityRunParams& p) : p_(p) {
+VehicleCoSim::VehicleCoSim(const MobilityRunParams& p, const VehicleSpec& spec) : p_(p) {
   // the chassis frame at x = 0 with the tires just touching the plane z = 0
-  vehicle_ = Vehicle::Load(p.vehicle_file, Eigen::Vector3d::Zero());
+  vehicle_ = Vehicle::Build(spec, Eigen::Vector3d::Zero());
   MultibodySystem& sys = vehicle_->system();
   const Eigen::Vector3d shift(0.0, 0.0, vehicle_->design_ride_height());
   for (int i = 1; i < sys.num_bodies(); ++i) sys.mutable_body(i).x += shift;

@@ -1,14 +1,15 @@
 #include "dem_mobility/core/mobility/mobility_scene.h"
 
-#include "dem_mobility/core/vehicle/vehicle.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 namespace dem_mobility {
 
 MobilityRun::MobilityRun(const MobilityRunParams& p)
-    : terrain_(LoadTerrainModel(p.terrain_file, TerrainVehicle{LoadTireGeometry(p.vehicle_file), kWheels})),
+    : spec_(VehicleSpec::Load(p.vehicle_file)),
+      terrain_(LoadTerrainModel(p.terrain_file, TerrainVehicle{spec_.tire, kWheels})),
       port_(*terrain_),
-      driver_(p.driver, p.vehicle_file),
-      sim_(p) {
+      driver_(p.driver, spec_),
+      sim_(p, spec_) {
   sim_.Start(port_);
 }
 

@@ -14,6 +14,7 @@
 namespace dem_mobility {
 
 class TerrainModel;
+struct VehicleSpec;
 
 /// The terrain: wheel states of step `step` at time `t` in, the wrenches for that step out; the
 /// terrain then advances to t + dt (`dt`: the time to the next exchange, 0 at the opening exchange
@@ -46,16 +47,15 @@ class LocalTerrainPort final : public TerrainPort {
   TerrainModel& model_;
 };
 
-/// The scene's speed driver for the vehicle in `vehicle_file` (its mass, wheel radius, driveline
-/// reduction and engine curves).
+/// The scene's speed driver for a vehicle (its mass, wheel radius, driveline reduction and engine
+/// curves, from the vehicle's spec: the driver never builds the vehicle).
 class SceneDriver final : public DriverPort {
  public:
-  SceneDriver(const DriverParams& p, const std::string& vehicle_file);
-  ~SceneDriver() override;
+  SceneDriver(const DriverParams& p, const VehicleSpec& vehicle);
   DriveCommand Exchange(const DriveInput& in) override;
 
  private:
-  std::unique_ptr<class Vehicle> vehicle_;  ///< only for its data: never stepped
+  PowertrainParams powertrain_;  ///< the driver's engine curves (SpeedDriver refers to them)
   SpeedDriver driver_;
 };
 

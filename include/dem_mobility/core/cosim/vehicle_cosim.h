@@ -9,12 +9,14 @@
 #include "dem_mobility/core/cosim/ports.h"
 #include "dem_mobility/core/mobility/mobility_run.h"
 #include "dem_mobility/core/vehicle/vehicle.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 namespace dem_mobility {
 
 class VehicleCoSim {
  public:
-  explicit VehicleCoSim(const MobilityRunParams& p);
+  /// The vehicle of `spec` (read from p.vehicle_file) with its tires just touching the plane z = 0.
+  VehicleCoSim(const MobilityRunParams& p, const VehicleSpec& spec);
   /// The opening exchange (step 0), then the time step: time_step, or time_step_safety x the
   /// smallest critical step of the vehicle's elements and the terrain contact it reported.
   /// Throws ConfigError (naming the scene file and time_step) for a step above that limit.

@@ -21,6 +21,7 @@ class MobilityRun {
   double dt() const { return sim_.dt(); }
 
  private:
+  VehicleSpec spec_;  ///< read once: the terrain, the driver and the vehicle take what they need
   std::unique_ptr<TerrainModel> terrain_;
   LocalTerrainPort port_;
   SceneDriver driver_;

@@ -1,4 +1,4 @@
-// The 33-body HMMWV-type vehicle of the paper (section 4.1), assembled from YAML.
+// The 33-body HMMWV-type vehicle of the paper (section 4.1), assembled from a VehicleSpec.
 #pragma once
 
 #include <array>
@@ -8,15 +8,18 @@
 #include "dem_mobility/core/cosim/exchange.h"
 #include "dem_mobility/core/multibody/multibody_system.h"
 #include "dem_mobility/core/vehicle/powertrain.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 namespace dem_mobility {
 
 /// Wheel order everywhere: front left, front right, rear left, rear right.
 enum WheelIndex { kFrontLeft = 0, kFrontRight = 1, kRearLeft = 2, kRearRight = 3 };
+/// The corners' names in WheelIndex order, as they appear in body and element names.
+inline constexpr const char* kCorner[4] = {"fl", "fr", "rl", "rr"};
 
-/// A vehicle assembled in a MultibodySystem: chassis; per corner upper and lower control arms,
-/// upright (knuckle) and wheel; steering rack and two tie rods; drive shaft; per axle pinion,
-/// carrier, two side gears and two half shafts. Penalty joints connect them (revolute = two
+/// A vehicle assembled in a MultibodySystem from a VehicleSpec: chassis; per corner upper and
+/// lower control arms, upright (knuckle) and wheel; steering rack and two tie rods; drive shaft;
+/// per axle pinion, carrier, two side gears and two half shafts. Penalty joints connect them (revolute = two
 /// spherical points on the axis); gears, differentials and CV joints are penalty couplings.
 ///
 /// The drive torque request and brake effort are set from outside; every force evaluation clamps
@@ -24,20 +27,21 @@ enum WheelIndex { kFrontLeft = 0, kFrontRight = 1, kRearLeft = 2, kRearRight = 3
 /// turns the brake effort into wheel torques at the current wheel speeds.
 class Vehicle {
  public:
-  /// Builds the vehicle described by `file` with its chassis reference frame at `position` (world).
-  /// The wheels touch nothing: the terrain's wrenches arrive through SetWheelWrench.
-  /// Throws ConfigError naming the file and key of any bad or unknown input.
-  static std::unique_ptr<Vehicle> Load(const std::string& file, const Eigen::Vector3d& position);
+  /// Assembles the vehicle `spec` describes with its chassis reference frame at `position` (world),
+  /// every body at rest with R = I. The wheels touch nothing: the terrain's wrenches arrive through
+  /// SetWheelWrench.
+  static std::unique_ptr<Vehicle> Build(const VehicleSpec& spec, const Eigen::Vector3d& position);
 
   MultibodySystem& system() { return system_; }
   const MultibodySystem& system() const { return system_; }
-  const PowertrainParams& powertrain() const { return powertrain_; }
-  const TireGeometry& tire() const { return tire_; }
-  const std::string& name() const { return name_; }
+  const VehicleSpec& spec() const { return spec_; }
+  const PowertrainParams& powertrain() const { return spec_.powertrain; }
+  const TireGeometry& tire() const { return spec_.tire; }
+  const std::string& name() const { return spec_.name; }
 
   int chassis() const { return chassis_; }
   /// Wheel speed / drive-shaft speed when all wheels turn alike (the final drive ratio).
-  double driveline_reduction() const { return reduction_; }
+  double driveline_reduction() const { return spec_.driveline_reduction(); }
   int wheel(int i) const { return wheels_[i]; }
   /// Distance from the ground plane under a wheel to the chassis reference frame at design.
   double design_ride_height() const { return ride_height_; }
@@ -59,35 +63,25 @@ class Vehicle {
 
   void SetDriveTorqueRequest(double t) { drive_request_ = t; }
   void SetBrakeEffort(double effort) { brake_effort_ = effort; }
-  /// Steering as a fraction of full lock in [-1, 1] (positive: left).
-  void SetSteering(double fraction);
   double AppliedDriveTorque() const;
   double BrakeEffort() const { return brake_effort_; }
 
  private:
+  friend class VehicleAssembler;
   Vehicle() = default;
   void ApplyPowertrain(MultibodySystem& sys);
 
   MultibodySystem system_;
-  PowertrainParams powertrain_;
-  TireGeometry tire_;
-  std::string name_;
+  VehicleSpec spec_;
   int chassis_ = -1;
   std::array<int, 4> wheels_{};
-  std::array<int, 4> uprights_{};
   std::array<int, 4> brakes_{};   ///< indices into system_.torques
   std::array<double, 4> brake_angle_{}, brake_anchor_{};  ///< wheel angle rel. upright; brake state
   int drive_ = -1;                ///< index into system_.torques
-  int steering_ = -1;             ///< index into system_.line_constraints
-  double max_rack_travel_ = 0.0;
-  double reduction_ = 0.0;
   Eigen::Vector3d chassis_com_offset_ = Eigen::Vector3d::Zero();
   double ride_height_ = 0.0;
   double drive_request_ = 0.0, brake_effort_ = 0.0;
   std::array<WheelWrench, 4> wrench_{};
 };
-
-/// The tire geometry of the vehicle in `file` (what a terrain needs of the vehicle).
-TireGeometry LoadTireGeometry(const std::string& file);
 
 }  // namespace dem_mobility
