@@ -12,7 +12,7 @@ double PairEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const Neighb
   const int j = lists.partners()[k];
   const double d = (e.diameter - (ps.x[i] - ps.x[j]).norm()) - (ps.plastic[i] + ps.plastic[j]);
   const double fmax = std::min(ps.adhesion_max[i], ps.adhesion_max[j]);
-  double u = lists.touching()[k] ? 0.5 * law.k_t * lists.histories()[k].spring.squaredNorm() : 0.0;
+  double u = lists.touching()[k] ? 0.5 * law.friction.k_t * lists.histories()[k].spring.squaredNorm() : 0.0;
   if (!(d > 0.0)) return u;
   const double d0 = law.d0, dp = law.dp;
   if (d > d0) u += 0.5 * law.k_n * (d - d0) * (d - d0);
