@@ -164,7 +164,10 @@ void DemSystem::Step() {
   ++step_;
   CheckParticleStates(ps_, dt_, half_skin, step_, time_);
   walls_.UpdateVertices();  // the walls' poses were set for this step from outside
-  if (rebuild_ || max_disp2 > half_skin * half_skin || walls_.MaxWallDisplacement() > half_skin) Rebuild();
+  if (rebuild_ || max_disp2 > half_skin * half_skin)
+    Rebuild();
+  else if (walls_.NeedsBuild(std::sqrt(max_disp2)))  // the walls moved: only their candidates
+    walls_.Build(ps_, settings_.threads, std::sqrt(max_disp2));
   const double power_before = ledger_.wall_power;
   ComputeForces();
   ledger_.wall_work += h * (power_before + ledger_.wall_power);  // trapezoidal
