@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "dem_mobility/core/common/asperity_friction.h"
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 
@@ -35,27 +36,21 @@ Vector3d ContactForce(const ContactParams& p, const Vector3d& point, const Vecto
   const double fn = std::max(0.0, f_rep + f_damp);
   *normal_force = fn;
 
-  // tangential: asperity friction (anchor spring || Coulomb element), capped at mu F_repulsion
+  // tangential: the asperity friction element, its anchor a point on the surface
   const Vector3d surface = point + depth * n;
   if (h->last_step != step - 1 && h->last_step != step) h->anchor = surface;
   h->last_step = step;
   const Vector3d vt = v - vn * n;
   Vector3d delta = surface - h->anchor;
   delta -= delta.dot(n) * n;
-  const double vt_norm = vt.norm();
-  Vector3d f_c = Vector3d::Zero();
-  if (vt_norm > 0.0) f_c = (-p.mu * f_rep * std::min(1.0, vt_norm / p.v_slip) / vt_norm) * vt;
-  const Vector3d f_spring = -p.k_t * delta - p.c_t_anchor * vt;
-  Vector3d f_t = f_spring + f_c;
-  const double limit = p.mu * f_rep;
-  const double ft_norm = f_t.norm();
-  if (ft_norm > limit) {
-    f_t *= limit / ft_norm;
-    // slip: move the anchor so that the spring carries what the Coulomb element does not
-    h->anchor = surface + (f_t - f_c) / p.k_t;
+  const AsperityFriction friction(p.mu, p.k_t, p.v_slip, p.c_t_anchor, p.c_visc);
+  bool slipped = false;
+  const Vector3d f_t = friction.Force<true>(vt, f_rep, &delta, &slipped);
+  if (slipped) {  // the anchor slid on the surface
+    h->anchor = surface - delta;
     h->anchor -= (h->anchor - surface).dot(n) * n;
   }
-  return fn * n + f_t - p.c_visc * vt;
+  return fn * n + f_t;
 }
 
 // ---------------------------------------------------------------------------------------------

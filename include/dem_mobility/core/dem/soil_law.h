@@ -13,6 +13,7 @@
 #include <cmath>
 #include <string>
 
+#include "dem_mobility/core/common/asperity_friction.h"
 #include "dem_mobility/core/common/table.h"
 
 namespace dem_mobility {
@@ -65,21 +66,18 @@ struct TangentialHistory {
 /// The contact law with its constants worked out once (the solver's inner loop); the free
 /// functions below are the same law for one-off use.
 struct SoilContactLaw {
-  double k_n, c_n, k_t, inv_k_t, d0, dp, inv_dp, inv_d0_dp, mu, s_n, v_slip, c_t;
+  double k_n, c_n, d0, dp, inv_dp, inv_d0_dp, s_n;
+  AsperityFriction friction;  ///< eq. 13-14, the viscosity c_t outside the cap
   bool cohesion;
   explicit SoilContactLaw(const SoilParams& p)
       : k_n(p.NormalStiffness()),
         c_n(p.NormalDamping()),
-        k_t(p.TangentialStiffness()),
-        inv_k_t(k_t > 0.0 ? 1.0 / k_t : 0.0),
         d0(p.adhesion_depth * p.diameter),
         dp(p.adhesion_peak * p.diameter),
         inv_dp(dp > 0.0 ? 1.0 / dp : 0.0),
         inv_d0_dp(d0 > dp ? 1.0 / (d0 - dp) : 0.0),
-        mu(p.friction),
         s_n(p.separation_factor),
-        v_slip(p.slip_velocity),
-        c_t(p.viscosity),
+        friction(p.friction, p.TangentialStiffness(), p.slip_velocity, 0.0, p.viscosity),
         cohesion(p.cohesion) {}
 
   // Branch-free in the penetration: in a packed bed the penetrations sit about d0, where a branch
@@ -94,26 +92,17 @@ struct SoilContactLaw {
     return f;
   }
 
+  /// The tangential force of a contact with unit normal n and sliding velocity vt: the anchor
+  /// spring is kept in the current tangent plane (projected, as LAMMPS' history springs are; the
+  /// length lost is second order in the turn per step) and stretched by vt dt.
   [[gnu::always_inline]] Eigen::Vector3d Tangential(const Eigen::Vector3d& n, const Eigen::Vector3d& vt, double f_rep,
                                                     double dt, TangentialHistory* h) const {
-    // keep the spring in the current tangent plane (projected, as LAMMPS' history springs are;
-    // the length lost is second order in the turn per step)
     Eigen::Vector3d s = h->spring;
     s -= s.dot(n) * n;
     s += vt * dt;
-    // Coulomb element: mu f_rep along -vt, linear below the slip velocity
-    const double c = -mu * f_rep / std::max(v_slip, vt.norm());
-    const Eigen::Vector3d f_c = c * vt;
-    Eigen::Vector3d f_t = -k_t * s + f_c;
-    const double limit = mu * std::max(0.0, f_rep);
-    const double ft2 = f_t.squaredNorm();
-    if (ft2 > limit * limit) {
-      f_t = ft2 > 0.0 ? Eigen::Vector3d(f_t * (limit / std::sqrt(ft2))) : Eigen::Vector3d::Zero();
-      // slip: the anchor moves so that the spring carries what the Coulomb element does not
-      s = -(f_t - f_c) * inv_k_t;
-    }
+    const Eigen::Vector3d f_t = friction.Force(vt, f_rep, &s);
     h->spring = s;
-    return f_t - c_t * vt;
+    return f_t;
   }
 };
 

@@ -1,0 +1,37 @@
+// The DEM's energies: kinetic, gravitational and the elastic energy stored in the contacts (the
+// repulsion, the adhesion triangle's potential and the anchor springs), and the ledger of what
+// walls, added and removed particles and gravity changes put in since Finalize.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "dem_mobility/core/common/energy.h"
+#include "dem_mobility/core/dem/neighbour_list.h"
+#include "dem_mobility/core/dem/particle_store.h"
+#include "dem_mobility/core/dem/soil_law.h"
+
+namespace dem_mobility {
+
+/// What the energy sums need besides the particles and their lists.
+struct DemEnergyTerms {
+  const SoilContactLaw* law;
+  double diameter, mass;
+  Eigen::Vector3d gravity;
+};
+
+/// The elastic energy of listed pair k of slot i.
+double PairEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists, int i, int k);
+/// Kinetic, gravitational and elastic energy of all live particles.
+EnergyReport MechanicalEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists);
+/// Slot i's kinetic and gravitational energy and that of all its pairs (what it takes away when removed).
+double ParticleEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists, int i);
+
+/// The energy put in from outside since Finalize.
+struct DemLedger {
+  double e0 = 0.0;          ///< mechanical energy at Finalize
+  double wall_work = 0.0;   ///< the walls' work on the particles (trapezoidal in time)
+  double exchanged = 0.0;   ///< particles added less removed, gravity changes
+  double wall_power = 0.0;  ///< the walls' power at the last force evaluation
+};
+
+}  // namespace dem_mobility

@@ -1,0 +1,95 @@
+// The DEM particles' storage: per-slot arrays (structure of arrays, as the solver's loops read
+// them), the stable IDs the caller sees, and the free slots. Slots are permuted at every neighbour
+// build (sorted by slab and cell); IDs never change and are never reused.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+namespace dem_mobility {
+
+/// What a slot holds.
+enum class SlotState : unsigned char {
+  kFree,    ///< nothing (never used, or its particle was removed)
+  kListed,  ///< a particle the last neighbour build listed
+  kAdded,   ///< a particle added since the last neighbour build
+};
+
+/// Where the particle with a given ID is.
+struct IdRecord {
+  enum class State : unsigned char {
+    kLive,     ///< in `slot`
+    kRemoved,  ///< removed; `slot` still holds its last state (until the slot is reused)
+    kGone,     ///< removed and its slot reused: no state left
+  };
+  State state = State::kGone;
+  int slot = -1;
+};
+
+/// Permutes a per-slot array of `width` entries per slot: new slot s takes old slot order[s].
+template <class T>
+void PermuteSlots(std::vector<T>* v, const std::vector<int>& order, size_t width) {
+  const std::vector<T> old = *v;
+  for (size_t s = 0; s < order.size(); ++s)
+    std::copy(old.begin() + static_cast<size_t>(order[s]) * width,
+              old.begin() + static_cast<size_t>(order[s] + 1) * width, v->begin() + s * width);
+}
+
+class ParticleStore {
+ public:
+  static constexpr int kNoId = -1;
+
+  // per slot (read and written directly by the solver's loops)
+  std::vector<Eigen::Vector3d> x, v, f;
+  std::vector<Eigen::Vector3d> x_built;  ///< position at the last neighbour build (or at its addition)
+  std::vector<double> plastic;           ///< plastic deformation [m]
+  std::vector<double> adhesion_max;      ///< maximum adhesion force [N]
+  // the largest repulsion, tension and overlap of the slot's contacts at the last force evaluation
+  std::vector<double> max_repulsion, max_tension, overlap;
+  std::vector<SlotState> state;
+  std::vector<int> id_of_slot;  ///< the ID whose (last) state the slot holds, or kNoId
+
+  int slots() const { return static_cast<int>(x.size()); }
+  bool live(int s) const { return state[s] != SlotState::kFree; }
+  /// IDs handed out so far (removed particles included).
+  int size() const { return static_cast<int>(ids_.size()); }
+  int num_alive() const { return size() - removed_; }
+  bool alive(int id) const { return ids_[id].state == IdRecord::State::kLive; }
+  const IdRecord& record(int id) const { return ids_.at(id); }
+  /// The slot of a live particle; ConfigError otherwise.
+  int LiveSlot(int id) const;
+
+  /// A new ID in the lowest free slot, or in a slot appended at the end (`*appended` says which);
+  /// the slot's state is reset (no plastic deformation, the given adhesion, zero maxima).
+  int Add(const Eigen::Vector3d& x0, const Eigen::Vector3d& v0, const Eigen::Vector3d& f0, double adhesion0,
+          SlotState st, bool* appended);
+  /// Frees the live particle's slot; its last state stays readable by ID until the slot is reused.
+  /// Returns the slot.
+  int Remove(int id);
+  /// New slot s takes old slot order[s] (x_built is not moved: a build sets it afterwards); the
+  /// ID records and the free slots follow.
+  void Permute(const std::vector<int>& order);
+
+  /// The value of a per-slot array for an ID (a removed particle: its last state; gone: NaN).
+  template <class T>
+  T Get(const std::vector<T>& a, int id) const {
+    const IdRecord& r = ids_.at(id);
+    if (r.state == IdRecord::State::kGone) return NaNLike(T());
+    return a[r.slot];
+  }
+  size_t MemoryBytes() const;
+
+ private:
+  static double NaNLike(double) { return std::numeric_limits<double>::quiet_NaN(); }
+  static Eigen::Vector3d NaNLike(const Eigen::Vector3d&) {
+    return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  }
+
+  std::vector<IdRecord> ids_;
+  std::vector<int> free_slots_;  ///< ascending
+  int removed_ = 0;
+};
+
+}  // namespace dem_mobility

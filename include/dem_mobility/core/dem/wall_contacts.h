@@ -1,0 +1,115 @@
+// Particle-wall contacts of the DEM: the walls, their world vertices, each slot's candidate
+// triangles, one tangential history per slot and wall, and the walls' wrenches.
+//
+// Candidates: the triangles whose bounding box, grown by the cutoff, holds the particle at the
+// wall build. A particle touches a triangle only within half a diameter of it, so the candidates
+// stay complete while the largest wall-vertex displacement plus the largest particle displacement
+// since the wall build stays below cutoff - d / 2 (the margin). The walls (a wheel moves much faster
+// than the soil) are rebuilt on their own when that is exceeded; a particle added since the last
+// neighbour build tries every triangle.
+//
+// The wrenches are summed in fixed chunks of slots, in slot order, and the chunks in order: the
+// same sums for any thread count, without a force per particle and wall.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "dem_mobility/core/dem/particle_store.h"
+#include "dem_mobility/core/dem/soil_law.h"
+#include "dem_mobility/core/geometry/trimesh.h"
+
+namespace dem_mobility {
+
+/// A rigid triangle mesh the particles touch: a container side, a lid, a cone, a wheel. Its pose
+/// and velocity are set from outside (static, prescribed motion, or driven by a multibody body);
+/// the solver returns the particles' total force on it and the moment about `wrench_point`.
+/// A particle touches a wall at one point (the deepest of its triangles), so a wall must be flat or
+/// convex; a container is several walls.
+struct DemWall {
+  std::string name;
+  TriMesh mesh;                                         ///< body coordinates
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();   ///< body origin, world
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();   ///< of the body origin, world
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< world
+  double friction = 0.5;          ///< particle-wall mu (0.5 to tire and cone, table 2)
+  double adhesion_factor = 0.0;   ///< wall adhesion as a fraction of the particle's maximum adhesion
+  Eigen::Vector3d wrench_point = Eigen::Vector3d::Zero();  ///< world point the moment is about
+  // results of the last force evaluation
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< on the wall, world
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();  ///< on the wall about wrench_point, world
+  int contacts = 0;
+};
+
+/// A flat rectangular wall: corner `o`, edges `e1` and `e2` (two triangles).
+DemWall MakeQuadWall(const std::string& name, const Eigen::Vector3d& o, const Eigen::Vector3d& e1,
+                     const Eigen::Vector3d& e2);
+
+class WallContacts {
+ public:
+  /// `cutoff`: the candidate box growth; `diameter`: the particles' contact diameter.
+  WallContacts(double cutoff, double diameter) : cutoff_(cutoff), diameter_(diameter) {}
+
+  /// Adds a wall (before the first build, `slots` slots so far); returns its index.
+  int Add(DemWall wall, const SoilParams& soil, int slots);
+  int size() const { return static_cast<int>(walls_.size()); }
+  DemWall& wall(int w) { return walls_[w]; }
+  const DemWall& wall(int w) const { return walls_[w]; }
+
+  /// A slot appended to the store (`built`: after the first build, so it gets an empty candidate list).
+  void AppendSlot(bool built);
+  /// Forgets slot s's wall contacts (its particle was added or removed).
+  void ClearSlot(int s);
+  /// Follows the store's permutation (new slot s holds old slot order[s]).
+  void PermuteSlots(const std::vector<int>& order);
+  /// The walls' world vertices from their present poses.
+  void UpdateVertices();
+  /// Whether the candidates may miss a contact once the particles have moved up to
+  /// `particle_displacement` from x_built.
+  bool NeedsBuild(double particle_displacement) const;
+  /// Each live slot's candidate triangles at the present positions; `particle_displacement`: the
+  /// largest distance of a particle from its x_built now (0 right after a neighbour build).
+  void Build(const ParticleStore& ps, int threads, double particle_displacement);
+  /// Adds the wall contacts' forces to the store's particles (and their maxima); sets the walls'
+  /// wrenches. Returns the walls' power on the particles.
+  double Compute(ParticleStore* ps, double dt, int threads);
+
+  /// The largest distance of a wall vertex from where it was at the wall build.
+  double MaxWallDisplacement() const;
+  long builds() const { return builds_; }
+  size_t MemoryBytes() const;
+
+ private:
+  struct WallTri {
+    int wall, face;
+  };
+  struct WallSum {
+    Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+    double power = 0.0;
+    int contacts = 0;
+  };
+  void ClearHistory(size_t hw) {
+    if (touching_[hw]) {
+      hist_[hw] = TangentialHistory();
+      touching_[hw] = 0;
+    }
+  }
+  void ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum);
+  double SumWrenches(int chunks);
+
+  double cutoff_, diameter_;
+  long builds_ = 0;
+  std::vector<DemWall> walls_;
+  std::vector<SoilContactLaw> law_;  ///< the soil law with each wall's friction
+  std::vector<std::vector<Eigen::Vector3d>> vertices_, built_vertices_;  ///< world, now and at the build
+  double built_particle_displacement_ = 0.0;  ///< the particles' largest distance from x_built at the build
+  std::vector<WallTri> tris_;
+  std::vector<int> tri_start_, tri_of_slot_;  ///< CSR: candidate triangles per slot, in wall order
+  std::vector<TangentialHistory> hist_;       ///< per slot and wall
+  std::vector<unsigned char> touching_;       ///< per slot and wall
+  std::vector<WallSum> chunk_;                ///< per chunk of slots and wall
+};
+
+}  // namespace dem_mobility

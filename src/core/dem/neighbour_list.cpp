@@ -1,0 +1,275 @@
+#include "dem_mobility/core/dem/neighbour_list.h"
+
+#include <cmath>
+
+namespace dem_mobility {
+
+using Eigen::Vector3d;
+
+Eigen::Vector3i NeighbourList::CellOf(const Vector3d& x) const {
+  // clamped: a particle outside the grid's box lands in a border cell, whose neighbour cells
+  // still hold every particle within one cell width of it
+  Eigen::Vector3i c;
+  for (int a = 0; a < 3; ++a) {
+    const double u = std::floor((x[a] - grid_lo_[a]) / cutoff_);
+    c[a] = u < 0.0 ? 0 : u >= grid_dims_[a] - 1 ? grid_dims_[a] - 1 : static_cast<int>(u);
+  }
+  return c;
+}
+
+std::vector<int> NeighbourList::Candidates(const ParticleStore& ps, const Vector3d& x) const {
+  std::vector<int> out;
+  ForEachSlotNear(CellOf(x), [&](int j) {
+    if (ps.state[j] == SlotState::kListed) out.push_back(j);
+  });
+  for (int j : added_since_build_)
+    if (ps.state[j] == SlotState::kAdded) out.push_back(j);
+  return out;
+}
+
+std::vector<long> NeighbourList::SetUpGrid(const ParticleStore& ps) {
+  // a uniform grid of cells one cutoff wide over the live particles' bounding box; the longest
+  // axis is the slab axis, made the slowest-varying one of the cell index. Returns each slot's
+  // cell (-1: free) and counts the slots per cell into cell_start_.
+  const int n = ps.slots();
+  Vector3d lo = Vector3d::Constant(1e300), hi = -lo;
+  for (int i = 0; i < n; ++i)
+    if (ps.live(i)) {
+      lo = lo.cwiseMin(ps.x[i]);
+      hi = hi.cwiseMax(ps.x[i]);
+    }
+  if (lo.x() > hi.x()) lo = hi = Vector3d::Zero();
+  grid_lo_ = lo;
+  for (int a = 0; a < 3; ++a) grid_dims_[a] = std::max(1, static_cast<int>((hi[a] - lo[a]) / cutoff_) + 1);
+  slab_axis_ = 0;
+  for (int a = 1; a < 3; ++a)
+    if (grid_dims_[a] > grid_dims_[slab_axis_]) slab_axis_ = a;
+  const int a1 = (slab_axis_ + 1) % 3, a2 = (slab_axis_ + 2) % 3;
+  grid_stride_[a1] = 1;
+  grid_stride_[a2] = grid_dims_[a1];
+  grid_stride_[slab_axis_] = static_cast<long>(grid_dims_[a1]) * grid_dims_[a2];
+  const long ncell = static_cast<long>(grid_dims_.x()) * grid_dims_.y() * grid_dims_.z();
+  std::vector<long> cell(n, -1);
+  cell_start_.assign(ncell + 1, 0);
+  for (int i = 0; i < n; ++i)
+    if (ps.live(i)) {
+      cell[i] = CellIndex(CellOf(ps.x[i]));
+      ++cell_start_[cell[i] + 1];
+    }
+  for (long c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
+  return cell;
+}
+
+std::vector<int> NeighbourList::SortSlots(ParticleStore* ps, const std::vector<long>& cell) {
+  // a stable counting sort of the live slots by cell (slab-major), the free slots last
+  const int n = ps->slots();
+  const long ncell = static_cast<long>(cell_start_.size()) - 1;
+  std::vector<int> order;  // order[new slot] = old slot
+  order.reserve(n);
+  {
+    std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+    order.resize(cell_start_[ncell]);
+    for (int i = 0; i < n; ++i)
+      if (cell[i] >= 0) order[fill[cell[i]]++] = i;
+    for (int i = 0; i < n; ++i)
+      if (cell[i] < 0) order.push_back(i);
+  }
+  ps->Permute(order);
+  // the old lists stay where they are, reached through the new slot numbers
+  PermuteSlots(&nbr_begin_, order, 1);
+  PermuteSlots(&nbr_end_, order, 1);
+  std::vector<int> new_of_old(n);
+  for (int s = 0; s < n; ++s) new_of_old[order[s]] = s;
+  for (int& j : nbr_) j = j >= 0 ? new_of_old[j] : j;
+  return order;
+}
+
+void NeighbourList::SetUpSlabs(int n) {
+  // slabs of whole cells, at least one cutoff thick, at most 64
+  const long ncell = static_cast<long>(cell_start_.size()) - 1;
+  cells_per_slab_ = std::max(1, (grid_dims_[slab_axis_] + 63) / 64);
+  const int ns = (grid_dims_[slab_axis_] + cells_per_slab_ - 1) / cells_per_slab_;
+  slab_start_.assign(ns + 1, 0);
+  Eigen::Vector3i c = Eigen::Vector3i::Zero();
+  for (int s = 0; s < ns; ++s) {
+    c[slab_axis_] = s * cells_per_slab_;
+    slab_start_[s] = cell_start_[CellIndex(c)];
+  }
+  slab_start_[ns] = cell_start_[ncell];
+  slab_of_.resize(n);
+  for (int s = 0; s < ns; ++s)
+    for (int i = slab_start_[s]; i < slab_start_[s + 1]; ++i) slab_of_[i] = s;
+  slab_added_.assign(ns, {});
+}
+
+const TangentialHistory* NeighbourList::FindHistory(int i, int j) const {
+  for (int k = nbr_begin_[i]; k < nbr_end_[i]; ++k)
+    if (nbr_[k] == j) return touching_[k] ? &hist_[k] : nullptr;
+  return nullptr;
+}
+
+void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
+  // each slot's partners within the cutoff in the pairs it owns (half list), ascending
+  const int n = ps.slots();
+  const double cut2 = cutoff_ * cutoff_;
+  const int live = cell_start_.back();
+  const std::vector<Vector3d>& x = ps.x;
+  std::vector<std::vector<int>> found(live);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int i = 0; i < live; ++i) {
+    std::vector<int>& out = found[i];
+    ForEachSlotNear(CellOf(x[i]), [&](int j) {
+      if (j != i && Owns(i, j) && (x[i] - x[j]).squaredNorm() < cut2) out.push_back(j);
+    });
+    std::sort(out.begin(), out.end());
+  }
+  // the lists in slot order, each with room for slack_ more
+  std::vector<int> begin(n), end(n), cap(n);
+  int total = 0;
+  for (int i = 0; i < n; ++i) {
+    begin[i] = total;
+    end[i] = total + (i < live ? static_cast<int>(found[i].size()) : 0);
+    cap[i] = i < live ? end[i] + slack_ : end[i];
+    total = cap[i];
+  }
+  std::vector<int> nbr(total, -1);
+  std::vector<TangentialHistory> hist(total);
+  std::vector<unsigned char> touching(total, 0);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int i = 0; i < live; ++i) {
+    // carry each surviving contact's history over, from whichever side owned it before
+    for (int k = begin[i], m = 0; k < end[i]; ++k, ++m) {
+      const int j = found[i][m];
+      nbr[k] = j;
+      if (const TangentialHistory* h = FindHistory(i, j)) {
+        hist[k] = *h;
+        touching[k] = 1;
+      } else if (const TangentialHistory* g = FindHistory(j, i)) {
+        hist[k].spring = -g->spring;
+        touching[k] = 1;
+      }
+    }
+  }
+  nbr_begin_.swap(begin);
+  nbr_end_.swap(end);
+  nbr_cap_.swap(cap);
+  nbr_.swap(nbr);
+  hist_.swap(hist);
+  touching_.swap(touching);
+}
+
+std::vector<int> NeighbourList::Build(ParticleStore* ps, int threads) {
+  const int n = ps->slots();
+  const std::vector<long> cell = SetUpGrid(*ps);
+  // the old lists (valid once built) are carried through the sort for the contact histories
+  if (static_cast<int>(nbr_begin_.size()) != n) {
+    nbr_begin_.assign(n, 0);
+    nbr_end_.assign(n, 0);
+    nbr_.clear();
+  }
+  std::vector<int> order = SortSlots(ps, cell);
+  SetUpSlabs(n);
+  ListPairs(*ps, threads);
+  for (int i = 0; i < n; ++i) {
+    ps->x_built[i] = ps->x[i];
+    if (ps->live(i)) ps->state[i] = SlotState::kListed;
+  }
+  added_since_build_.clear();
+  return order;
+}
+
+void NeighbourList::AppendSlot() {
+  nbr_begin_.push_back(static_cast<int>(nbr_.size()));
+  nbr_end_.push_back(nbr_begin_.back());
+  nbr_cap_.push_back(nbr_begin_.back());
+  slab_of_.push_back(0);
+}
+
+bool NeighbourList::Insert(const ParticleStore& ps, int p) {
+  // its neighbours at their positions at the last build (or at their addition): as in a build,
+  // so the skin guarantee holds for the new pairs. Its slab from where it is: within a cutoff of
+  // its neighbours' positions, so at most one slab from theirs.
+  const double cut2 = cutoff_ * cutoff_;
+  const Vector3d& xp = ps.x[p];
+  added_since_build_.push_back(p);
+  slab_of_[p] = SlabOfCell(CellOf(xp));
+  slab_added_[slab_of_[p]].push_back(p);
+  std::vector<int> found;
+  for (int j : Candidates(ps, xp))
+    if (j != p && (ps.x_built[j] - xp).squaredNorm() < cut2) found.push_back(j);
+  std::sort(found.begin(), found.end());
+  // the pairs it owns in a list of its own at the end of the pool, with room to spare
+  std::vector<int> own;
+  for (int j : found)
+    if (Owns(p, j)) own.push_back(j);
+  nbr_begin_[p] = static_cast<int>(nbr_.size());
+  nbr_end_[p] = nbr_begin_[p] + static_cast<int>(own.size());
+  nbr_cap_[p] = nbr_end_[p] + slack_;
+  nbr_.insert(nbr_.end(), own.begin(), own.end());
+  nbr_.resize(nbr_cap_[p], -1);
+  hist_.resize(nbr_cap_[p]);
+  touching_.resize(nbr_cap_[p], 0);
+  for (int k = nbr_begin_[p]; k < nbr_cap_[p]; ++k) {
+    hist_[k] = TangentialHistory();
+    touching_[k] = 0;
+  }
+  for (int j : found)
+    if (!Owns(p, j) && !InsertPair(j, p)) return false;
+  return true;
+}
+
+bool NeighbourList::InsertPair(int i, int j) {
+  if (nbr_end_[i] == nbr_cap_[i]) return false;
+  int k = nbr_end_[i];
+  while (k > nbr_begin_[i] && nbr_[k - 1] > j) {  // keep the list ascending
+    nbr_[k] = nbr_[k - 1];
+    hist_[k] = hist_[k - 1];
+    touching_[k] = touching_[k - 1];
+    --k;
+  }
+  nbr_[k] = j;
+  hist_[k] = TangentialHistory();
+  touching_[k] = 0;
+  ++nbr_end_[i];
+  return true;
+}
+
+void NeighbourList::Remove(const ParticleStore& ps, int i) {
+  // its pairs: those it owns, and those its neighbours own
+  nbr_end_[i] = nbr_begin_[i];
+  for (int j : Candidates(ps, ps.x_built[i]))
+    if (j != i && Owns(j, i)) RemovePair(j, i);
+  if (ps.state[i] == SlotState::kAdded) {
+    std::vector<int>& added = slab_added_[slab_of_[i]];
+    added.erase(std::find(added.begin(), added.end(), i));
+  }
+}
+
+void NeighbourList::RemovePair(int i, int j) {
+  int k = nbr_begin_[i];
+  while (k < nbr_end_[i] && nbr_[k] != j) ++k;
+  if (k == nbr_end_[i]) return;
+  for (; k + 1 < nbr_end_[i]; ++k) {
+    nbr_[k] = nbr_[k + 1];
+    hist_[k] = hist_[k + 1];
+    touching_[k] = touching_[k + 1];
+  }
+  --nbr_end_[i];
+}
+
+int NeighbourList::contacts() const {
+  int c = 0;
+  for (size_t i = 0; i < nbr_begin_.size(); ++i)
+    for (int k = nbr_begin_[i]; k < nbr_end_[i]; ++k) c += touching_[k];
+  return c;
+}
+
+size_t NeighbourList::MemoryBytes() const {
+  auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  size_t b = bytes(nbr_begin_) + bytes(nbr_end_) + bytes(nbr_cap_) + bytes(nbr_) + bytes(hist_) + bytes(touching_) +
+             bytes(cell_start_) + bytes(added_since_build_) + bytes(slab_of_) + bytes(slab_start_);
+  for (const auto& a : slab_added_) b += bytes(a);
+  return b;
+}
+
+}  // namespace dem_mobility
