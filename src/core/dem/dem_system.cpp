@@ -164,9 +164,9 @@ void DemSystem::Step() {
   ++step_;
   CheckParticleStates(ps_, dt_, half_skin, step_, time_);
   walls_.UpdateVertices();  // the walls' poses were set for this step from outside
-  if (rebuild_ || max_disp2 > half_skin * half_skin)
-    Rebuild();
-  else if (walls_.NeedsBuild(std::sqrt(max_disp2)))  // the walls moved: only their candidates
+  if (rebuild_ || max_disp2 > half_skin * half_skin || walls_.MaxWallDisplacement(false) > half_skin)
+    Rebuild();  // the particles or a slow wall moved half the skin
+  else if (walls_.NeedsBuild(std::sqrt(max_disp2)))  // a fast wall moved: only the wall candidates
     walls_.Build(ps_, settings_.threads, std::sqrt(max_disp2));
   const double power_before = ledger_.wall_power;
   ComputeForces();

@@ -62,10 +62,10 @@ void WallContacts::UpdateVertices() {
   }
 }
 
-double WallContacts::MaxWallDisplacement() const {
+double WallContacts::MaxWallDisplacement(bool fast) const {
   double m2 = 0.0;
   for (size_t w = 0; w < vertices_.size() && w < built_vertices_.size(); ++w)
-    for (size_t k = 0; k < vertices_[w].size(); ++k)
+    for (size_t k = 0; k < vertices_[w].size() && walls_[w].fast == fast; ++k)
       m2 = std::max(m2, (vertices_[w][k] - built_vertices_[w][k]).squaredNorm());
   return std::sqrt(m2);
 }
@@ -75,7 +75,8 @@ bool WallContacts::NeedsBuild(double particle_displacement) const {
   // a particle's distance from where it was at the wall build is at most its distance from x_built
   // now plus the largest such distance at the build
   const double margin = cutoff_ - 0.5 * diameter_;
-  return MaxWallDisplacement() + particle_displacement + built_particle_displacement_ > margin;
+  const double walls = std::max(MaxWallDisplacement(true), MaxWallDisplacement(false));
+  return walls + particle_displacement + built_particle_displacement_ > margin;
 }
 
 void WallContacts::Build(const ParticleStore& ps, int threads, double particle_displacement) {

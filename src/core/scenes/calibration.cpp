@@ -30,9 +30,8 @@ CiCalibration CiCalibration::Read(const YamlReader& y) {
     if (!(c.f[k] > 0.0)) y.Fail("table", "cohesion factors must be > 0");
     if (k > 0 && !(c.f[k] > c.f[k - 1])) y.Fail("table", "f must increase with CI");
   }
-  const std::vector<double> cubic = y.DoubleList("cubic");
-  if (cubic.size() != 4) y.Fail("cubic", "must hold 4 coefficients (CI^3, CI^2, CI, 1)");
-  std::copy(cubic.begin(), cubic.end(), c.cubic.begin());
+  // the fit the sweep wrote beside the table (for people; scenes interpolate in the table)
+  if (y.DoubleList("cubic").size() != 4) y.Fail("cubic", "must hold 4 coefficients (CI^3, CI^2, CI, 1)");
   c.band = y.DoubleIn("band", 0.0, 10.0, 0.0);
   // what the sweep wrote for people: where it came from and the runs behind it
   for (const char* key : {"scene", "date", "method"}) y.String(key, "");

@@ -37,6 +37,10 @@ struct DemWall {
   double friction = 0.5;          ///< particle-wall mu (0.5 to tire and cone, table 2)
   double adhesion_factor = 0.0;   ///< wall adhesion as a fraction of the particle's maximum adhesion
   Eigen::Vector3d wrench_point = Eigen::Vector3d::Zero();  ///< world point the moment is about
+  /// A fast tool (a wheel: much faster than the soil): its motion rebuilds only the wall candidates
+  /// (WallContacts::NeedsBuild). A slow one (container, lid, cone) moving half the skin rebuilds
+  /// the particles' neighbour lists too, as a particle moving that far does.
+  bool fast = false;
   // results of the last force evaluation
   Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< on the wall, world
   Eigen::Vector3d moment = Eigen::Vector3d::Zero();  ///< on the wall about wrench_point, world
@@ -76,8 +80,9 @@ class WallContacts {
   /// wrenches. Returns the walls' power on the particles.
   double Compute(ParticleStore* ps, double dt, int threads);
 
-  /// The largest distance of a wall vertex from where it was at the wall build.
-  double MaxWallDisplacement() const;
+  /// The largest distance of a vertex of the fast (or the slow) walls from where it was at the
+  /// wall build.
+  double MaxWallDisplacement(bool fast) const;
   long builds() const { return builds_; }
   size_t MemoryBytes() const;
 

@@ -3,7 +3,6 @@
 // by scripts/calibrate_cone_index.py from a sweep of cone penetrometer runs; the soil scenes read it.
 #pragma once
 
-#include <array>
 #include <string>
 #include <vector>
 
@@ -16,7 +15,6 @@ struct CiCalibration {
   double friction = 0.0;               ///< the inter-particle mu it holds for
   std::string level;                   ///< fidelity level of the runs behind it
   std::vector<double> ci, f;           ///< table rows, CI strictly increasing, f increasing
-  std::array<double, 4> cubic{};       ///< f = c0 CI^3 + c1 CI^2 + c2 CI + c3 (the fit)
   double band = 0.0;                   ///< relative CI scatter of the runs about the fit (rms)
 
   /// Reads a calibration file; ConfigError names file and key (rows not increasing, ...).
