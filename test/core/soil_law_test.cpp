@@ -29,7 +29,7 @@ TEST(SoilLaw, NormalForceFollowsTheAdhesionRepulsionCurve) {
   const double d0 = p.adhesion_depth * kD, dp = p.adhesion_peak * kD, fmax = 2.0;  // fig. 7, from the file
   for (int i = -10; i <= 300; ++i) {
     const double x = i * 0.01 * d0;  // from -0.1 d0 (apart) to 3 d0
-    const SoilNormalForce f = ComputeSoilNormalForce(p, x, 0.0, fmax);
+    const SoilNormalForce f = SoilContactLaw(p).Normal(x, 0.0, fmax);
     double expected = 0.0;
     if (x > 0.0 && x <= dp) expected = -fmax * x / dp;                   // adhesion builds up
     else if (x > dp && x < d0) expected = -fmax * (d0 - x) / (d0 - dp);  // and fades to d0
@@ -39,17 +39,17 @@ TEST(SoilLaw, NormalForceFollowsTheAdhesionRepulsionCurve) {
     EXPECT_GE(f.repulsion, 0.0);
   }
   // the largest pull is exactly the maximum adhesion, at the peak penetration
-  EXPECT_NEAR(ComputeSoilNormalForce(p, dp, 0.0, fmax).Total(), -fmax, 1e-12);
+  EXPECT_NEAR(SoilContactLaw(p).Normal(dp, 0.0, fmax).Total(), -fmax, 1e-12);
 }
 
 TEST(SoilLaw, DampingOnApproachAndReducedBySnOnSeparation) {
   const SoilParams p = Nominal();
   const double d = 2.0 * p.adhesion_depth * kD;
   const double elastic = kKn * (d - p.adhesion_depth * kD);
-  EXPECT_NEAR(ComputeSoilNormalForce(p, d, 0.5, 0.0).Total(), elastic + kCn * 0.5, 1e-9);
-  EXPECT_NEAR(ComputeSoilNormalForce(p, d, -0.5, 0.0).Total(), elastic - 0.1 * kCn * 0.5, 1e-9);
+  EXPECT_NEAR(SoilContactLaw(p).Normal(d, 0.5, 0.0).Total(), elastic + kCn * 0.5, 1e-9);
+  EXPECT_NEAR(SoilContactLaw(p).Normal(d, -0.5, 0.0).Total(), elastic - 0.1 * kCn * 0.5, 1e-9);
   // out of contact: nothing, whatever the rate
-  EXPECT_EQ(ComputeSoilNormalForce(p, -1e-4, 1.0, 5.0).Total(), 0.0);
+  EXPECT_EQ(SoilContactLaw(p).Normal(-1e-4, 1.0, 5.0).Total(), 0.0);
 }
 
 TEST(SoilLaw, PlasticDeformationGrowsAlongFig8AndStaysAfterUnloading) {
@@ -123,20 +123,20 @@ TEST(SoilLaw, StickBelowAndSlipAboveMuTimesTheRepulsion) {
   TangentialHistory h;
   const Eigen::Vector3d v(1e-4, 0, 0);  // a tenth of the slip velocity: the Coulomb element gives 0.1 mu F
   Eigen::Vector3d f;
-  for (int i = 0; i < 10; ++i) f = ComputeSoilTangentialForce(p, n, v, f_rep, dt, &h);
+  for (int i = 0; i < 10; ++i) f = SoilContactLaw(p).Tangential(n, v, f_rep, dt, &h);
   // stick: anchor spring plus the Coulomb element, opposing the motion
   const double stick = k_t * 10 * 1e-4 * dt + 0.1 * mu * f_rep;
   ASSERT_LT(stick, mu * f_rep);
   EXPECT_NEAR(f.x(), -stick, 1e-9);
   EXPECT_NEAR(f.y(), 0.0, 1e-12);
   // keep pushing: the force stops at mu F_repulsion and the anchor slides
-  for (int i = 0; i < 1000; ++i) f = ComputeSoilTangentialForce(p, n, v, f_rep, dt, &h);
+  for (int i = 0; i < 1000; ++i) f = SoilContactLaw(p).Tangential(n, v, f_rep, dt, &h);
   EXPECT_NEAR(f.norm(), mu * f_rep, 1e-12);
   // stop: the spring keeps what it carried while sliding (mu F less the Coulomb element's share)
-  f = ComputeSoilTangentialForce(p, n, Eigen::Vector3d::Zero(), f_rep, dt, &h);
+  f = SoilContactLaw(p).Tangential(n, Eigen::Vector3d::Zero(), f_rep, dt, &h);
   EXPECT_NEAR(f.x(), -(mu * f_rep - 0.1 * mu * f_rep), 1e-9);
   // no repulsion (only adhesion): no friction
-  EXPECT_EQ(ComputeSoilTangentialForce(p, n, v, 0.0, dt, &h).norm(), 0.0);
+  EXPECT_EQ(SoilContactLaw(p).Tangential(n, v, 0.0, dt, &h).norm(), 0.0);
 }
 
 TEST(SoilLaw, BadSoilFileNamesTheFileAndKey) {

@@ -42,10 +42,6 @@ SoilParams SoilParams::Read(const YamlReader& y) {
 double SoilParams::Area() const { return 0.25 * M_PI * diameter * diameter; }
 double SoilParams::Mass() const { return density * M_PI * diameter * diameter * diameter / 6.0; }
 
-SoilNormalForce ComputeSoilNormalForce(const SoilParams& p, double d, double d_dot, double f_adh_max) {
-  return SoilContactLaw(p).Normal(d, d_dot, f_adh_max);
-}
-
 double MaxAdhesionForce(const SoilParams& p, double delta_p) {
   if (!p.cohesion) return 0.0;
   return p.cohesion_factor * p.adhesion_stress_vs_plastic_strain(delta_p / p.diameter) * p.Area();
@@ -59,25 +55,12 @@ double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_
   // eq. 16 relaxes the deformation at V_relax "due to tension and/or removal of the compression":
   // while the particle's largest compressive force is below the largest tensile (adhesive) force
   // it carries, both taken over its contacts now (the paper's "maximum force value over all adjacent
-  // particles"), or while nothing compresses it. Compared with the maximum adhesion the particle
-  // could carry (fig. 10), as a literal reading of eq. 16 has it, a consolidated particle would
-  // relax under any load below f x fig. 10: with the tuned fig. 10 (3.5 N at f = 1, 14x a particle's
-  // weight) every particle of a settled bed relaxed, each relaxation step pushing its compressed
-  // contacts apart (work F_repulsion V_relax dt), and a box of poured soil never came to rest
-  // (0.3 m/s at f = 1, 1 m/s at f = 12; docs/soil-model.md). Relaxing only while tension
-  // dominates puts little net work in: what it adds at the compressed contacts it takes back at
-  // the adhesive ones, which it deepens.
-  // Floored at zero and at what fig. 8 gives for the present load (only the part left from
-  // earlier, higher loads relaxes): relaxing below it would make the next step grow it back by up
-  // to V_relax dt, a force jump of k_n V_relax dt (0.7 N for table 2) that keeps a lightly loaded
-  // particle hopping.
+  // particles"), or while nothing compresses it (why this reading: docs/soil-model.md, "Reading of eq. 16").
+  // Floored at what fig. 8 gives for the present load: only the part left from earlier, higher
+  // loads relaxes, so the next step does not grow it back by V_relax dt (a force jump of
+  // k_n V_relax dt on a lightly loaded particle).
   if (max_repulsion < max_tension || max_repulsion <= 0.0) return std::max(target, delta_p - p.relax_speed * dt);
   return delta_p;
-}
-
-Eigen::Vector3d ComputeSoilTangentialForce(const SoilParams& p, const Eigen::Vector3d& n, const Eigen::Vector3d& vt,
-                                           double f_rep, double dt, TangentialHistory* h) {
-  return SoilContactLaw(p).Tangential(n, vt, f_rep, dt, h);
 }
 
 }  // namespace dem_mobility

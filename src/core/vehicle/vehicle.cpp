@@ -61,7 +61,7 @@ TimeStepLimit Vehicle::WheelContactLimit(double stiffness, double damping) const
     const double dt = CriticalStep(std::sqrt(w2), zeta);
     if (dt < lim.dt_crit) {
       lim.dt_crit = dt;
-      lim.element = std::string("wheel-terrain contact 'tire_") + kCorner[i] + "'";
+      lim.element = std::string("wheel-terrain contact 'tire_") + kWheelNames[i] + "'";
       lim.detail = detail::Concat("terrain contact stiffness ", stiffness, " N/m, damping ", damping, " N s/m on '",
                                   b.name, "' ", b.mass, " kg");
     }

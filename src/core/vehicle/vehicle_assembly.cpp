@@ -171,7 +171,7 @@ void VehicleAssembler::Corner(int axle, int side) {
   const SuspensionSpec::Hardpoints& h = suspension.hardpoints;
   auto point = [&](const Vector3d& left) { return suspension.Corner(left, side); };
   const int corner = axle * 2 + side;
-  const std::string c = kCorner[corner];
+  const std::string c = kWheelNames[corner];
   const int chassis = vehicle_->chassis_;
 
   const int upright = Body("upright_" + c, suspension.upright, point(h.upright));
@@ -285,7 +285,7 @@ void VehicleAssembler::Axle(int axle) {
     const double s = side == 0 ? 1.0 : -1.0;
     const Vector3d inner = centre + Vector3d(0, s * driveline.half_shaft_inner_offset, 0);
     const Vector3d outer = spindle_[corner] - Vector3d(0, s * driveline.half_shaft_outer_inset, 0);
-    const std::string c = kCorner[corner];
+    const std::string c = kWheelNames[corner];
     const int half_shaft = Rod("half_shaft_" + c, driveline.half_shaft, inner, outer);
     const Vector3d axis = (s * (outer - inner)).normalized();  // points to +y on both sides
     ConstantVelocity("cv_inner_" + c, side_gear[side], half_shaft, inner, Vector3d::UnitY(), axis);

@@ -63,8 +63,8 @@ struct TangentialHistory {
   Eigen::Vector3d spring = Eigen::Vector3d::Zero();
 };
 
-/// The contact law with its constants worked out once (the solver's inner loop); the free
-/// functions below are the same law for one-off use.
+/// The contact law of a pair (or a particle and a wall) with its constants worked out once: the
+/// solver's inner loop, and what the tests check against the formulas.
 struct SoilContactLaw {
   double k_n, c_n, d0, dp, inv_dp, inv_d0_dp, s_n;
   AsperityFriction friction;  ///< eq. 13-14, the viscosity c_t outside the cap
@@ -80,6 +80,11 @@ struct SoilContactLaw {
         friction(p.friction, p.TangentialStiffness(), p.slip_velocity, 0.0, p.viscosity),
         cohesion(p.cohesion) {}
 
+  /// Normal force of a contact with effective penetration `d` (the geometric overlap less the
+  /// plastic deformations of the two particles), penetration rate `d_dot` (> 0 approaching) and
+  /// maximum adhesion `f_adh_max` [N] (fig. 7): for 0 < d < d0 attractive, rising to -f_adh_max at
+  /// the peak penetration and back to 0 at d0; beyond d0 repulsive, k_n (d - d0). Damping c_n d_dot,
+  /// times s_n while separating. No force for d <= 0.
   // Branch-free in the penetration: in a packed bed the penetrations sit about d0, where a branch
   // on the adhesion/repulsion boundary is mispredicted half the time.
   [[gnu::always_inline]] SoilNormalForce Normal(double d, double d_dot, double f_adh_max) const {
@@ -92,9 +97,11 @@ struct SoilContactLaw {
     return f;
   }
 
-  /// The tangential force of a contact with unit normal n and sliding velocity vt: the anchor
-  /// spring is kept in the current tangent plane (projected, as LAMMPS' history springs are; the
-  /// length lost is second order in the turn per step) and stretched by vt dt.
+  /// Tangential force (eq. 13-14) of a contact with unit normal `n` (from the other body toward
+  /// this one), relative tangential velocity `vt` (this body's contact point relative to the
+  /// other's) and repulsive force `f_rep`, on this body: the anchor spring is kept in the current
+  /// tangent plane (projected, as LAMMPS' history springs are; the length lost is second order in
+  /// the turn per step) and stretched by vt dt; the anchor slides when the force exceeds mu f_rep.
   [[gnu::always_inline]] Eigen::Vector3d Tangential(const Eigen::Vector3d& n, const Eigen::Vector3d& vt, double f_rep,
                                                     double dt, TangentialHistory* h) const {
     Eigen::Vector3d s = h->spring;
@@ -105,13 +112,6 @@ struct SoilContactLaw {
     return f_t;
   }
 };
-
-/// Normal force of a contact with effective penetration `d` (the geometric overlap less the plastic
-/// deformations of the two particles), penetration rate `d_dot` (> 0 approaching) and maximum
-/// adhesion `f_adh_max` [N] (fig. 7): for 0 < d < d0 attractive, rising to -f_adh_max at the peak
-/// penetration and back to 0 at d0; beyond d0 repulsive, k_n (d - d0). Damping c_n d_dot, times
-/// s_n while separating. No force for d <= 0.
-SoilNormalForce ComputeSoilNormalForce(const SoilParams& p, double d, double d_dot, double f_adh_max);
 
 /// Maximum adhesion force of a particle with plastic deformation `delta_p` [m]: f x fig. 10 at the
 /// plastic strain delta_p / d, times the area. 0 when cohesion is off.
@@ -124,14 +124,5 @@ double MaxAdhesionForce(const SoilParams& p, double delta_p);
 /// load (see soil_law.cpp). Unchanged when plasticity is off.
 double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double max_tension,
                                 double dt);
-
-
-/// Tangential force (eq. 13-14) of a contact with unit normal `n` (from the other body toward
-/// this one), relative tangential velocity `vt` (this body's contact point relative to the other's,
-/// in the tangent plane) and repulsive force `f_rep`; advances the anchor spring by vt dt, keeps it
-/// in the tangent plane and slides the anchor when the force exceeds mu f_rep. Returns the force on
-/// this body.
-Eigen::Vector3d ComputeSoilTangentialForce(const SoilParams& p, const Eigen::Vector3d& n, const Eigen::Vector3d& vt,
-                                           double f_rep, double dt, TangentialHistory* h);
 
 }  // namespace dem_mobility

@@ -12,10 +12,8 @@
 
 namespace dem_mobility {
 
-/// Wheel order everywhere: front left, front right, rear left, rear right.
+/// Wheel order everywhere (kWheelNames, cosim/exchange.h): front left, front right, rear left, rear right.
 enum WheelIndex { kFrontLeft = 0, kFrontRight = 1, kRearLeft = 2, kRearRight = 3 };
-/// The corners' names in WheelIndex order, as they appear in body and element names.
-inline constexpr const char* kCorner[4] = {"fl", "fr", "rl", "rr"};
 
 /// A vehicle assembled in a MultibodySystem from a VehicleSpec: chassis; per corner upper and
 /// lower control arms, upright (knuckle) and wheel; steering rack and two tie rods; drive shaft;
