@@ -15,7 +15,7 @@
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_mobility/core/scenes/dem_pour.h"
 
-using namespace dem_mobility;
+using namespace dem_mobility::core;
 using Eigen::Vector3d;
 
 namespace {

@@ -10,7 +10,7 @@
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/mobility/mobility_scene.h"
 
-using namespace dem_mobility;
+using namespace dem_mobility::core;
 
 namespace {
 struct Figures {

@@ -2,6 +2,7 @@
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 namespace {
@@ -81,7 +82,7 @@ void FromMsg(const WheelWrenches& m, std::vector<WheelWrench>* w) {
   }
 }
 
-void ToMsg(const DriveInput& in, DriverInput* m) {
+void ToMsg(const core::DriverInput& in, dem_mobility::DriverInput* m) {
   m->step = static_cast<uint64_t>(in.step);
   m->time = in.time;
   m->period = in.period;
@@ -89,8 +90,8 @@ void ToMsg(const DriveInput& in, DriverInput* m) {
   m->drive_shaft_speed = in.drive_shaft_speed;
 }
 
-DriveInput FromMsg(const DriverInput& m) {
-  DriveInput in;
+core::DriverInput FromMsg(const dem_mobility::DriverInput& m) {
+  core::DriverInput in;
   in.step = static_cast<long>(m.step);
   in.time = m.time;
   in.period = m.period;
@@ -99,7 +100,7 @@ DriveInput FromMsg(const DriverInput& m) {
   return in;
 }
 
-void ToMsg(const DriveCommand& c, DriverCommand* m) {
+void ToMsg(const core::DriverCommand& c, dem_mobility::DriverCommand* m) {
   m->speed_command = c.speed_command;
   m->torque_request = c.torque_request;
   m->drive_torque = c.drive_torque;
@@ -108,8 +109,8 @@ void ToMsg(const DriveCommand& c, DriverCommand* m) {
   m->wot_limited = c.wot_limited;
 }
 
-DriveCommand FromMsg(const DriverCommand& m) {
-  DriveCommand c;
+core::DriverCommand FromMsg(const dem_mobility::DriverCommand& m) {
+  core::DriverCommand c;
   c.speed_command = m.speed_command;
   c.torque_request = m.torque_request;
   c.drive_torque = m.drive_torque;

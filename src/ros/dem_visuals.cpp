@@ -1,4 +1,5 @@
 #include "dem_mobility/ros/dem_visuals.h"
+#include "dem_mobility/ros/core_names.h"
 
 #include <Eigen/Geometry>
 #include <sensor_msgs/point_cloud2_iterator.h>

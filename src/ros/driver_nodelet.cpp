@@ -7,6 +7,7 @@
 #include "dem_mobility/core/cosim/ports.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 #include "dem_mobility/ros/conversions.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 
@@ -22,31 +23,31 @@ class DriverNodelet : public nodelet::Nodelet {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     std::string transport;
-    std::unique_ptr<ExchangeServer<DriverInput, DriverCommand>> server;
+    std::unique_ptr<ExchangeServer<dem_mobility::DriverInput, dem_mobility::DriverCommand>> server;
     try {
       const MobilityRunParams scene = LoadScene(nh);
       const ExchangeTiming timing = LoadExchangeTiming(pnh, &transport);
       driver_ = std::make_unique<SceneDriver>(scene.driver, VehicleSpec::Load(scene.vehicle_file));
-      server = std::make_unique<ExchangeServer<DriverInput, DriverCommand>>(
+      server = std::make_unique<ExchangeServer<dem_mobility::DriverInput, dem_mobility::DriverCommand>>(
           nh, transport, nh.resolveName("exchange/driver"), "exchange/driver_input", "exchange/driver_command", timing);
       NODELET_INFO("driver: %.2f m/s^2 toward %.1f m/s, every %.4g s, exchange over %s", scene.driver.accel,
                    scene.driver.v_max, scene.driver.control_period, transport.c_str());
     } catch (const std::exception& e) {
       NODELET_FATAL("%s", e.what());
-      failed_ = RefuseExchange<DriverInput, DriverCommand>(transport, nh.resolveName("exchange/driver"),
+      failed_ = RefuseExchange<dem_mobility::DriverInput, dem_mobility::DriverCommand>(transport, nh.resolveName("exchange/driver"),
                                                           std::string("the driver could not start: ") + e.what());
       return;
     }
-    responder_ = std::make_unique<ExchangeResponder<DriverInput, DriverCommand>>(
-        std::move(server), "driver", [this](const DriverInput& req) { return Answer(req); },
+    responder_ = std::make_unique<ExchangeResponder<dem_mobility::DriverInput, dem_mobility::DriverCommand>>(
+        std::move(server), "driver", [this](const dem_mobility::DriverInput& req) { return Answer(req); },
         [this](const std::string& m) { NODELET_ERROR("%s", m.c_str()); },
         [this](const std::string& m) { NODELET_INFO("%s", m.c_str()); });
   }
 
   /// The driver's command for one control step.
-  DriverCommand::ConstPtr Answer(const DriverInput& req) {
-    const DriveCommand c = driver_->Exchange(FromMsg(req));
-    auto resp = boost::make_shared<DriverCommand>();
+  dem_mobility::DriverCommand::ConstPtr Answer(const dem_mobility::DriverInput& req) {
+    const core::DriverCommand c = driver_->Exchange(FromMsg(req));
+    auto resp = boost::make_shared<dem_mobility::DriverCommand>();
     resp->header = req.header;
     resp->step = req.step;
     ToMsg(c, resp.get());
@@ -55,8 +56,8 @@ class DriverNodelet : public nodelet::Nodelet {
   }
 
   std::unique_ptr<SceneDriver> driver_;
-  std::unique_ptr<ExchangeResponder<DriverInput, DriverCommand>> responder_;
-  std::shared_ptr<Channel<DriverInput, DriverCommand>> failed_;  ///< held closed when the setup failed
+  std::unique_ptr<ExchangeResponder<dem_mobility::DriverInput, dem_mobility::DriverCommand>> responder_;
+  std::shared_ptr<Channel<dem_mobility::DriverInput, dem_mobility::DriverCommand>> failed_;  ///< held closed when the setup failed
   uint64_t served_ = 0;
 };
 

@@ -13,6 +13,7 @@
 #include <pluginlib/class_list_macros.hpp>
 
 #include "dem_mobility/ros/conversions.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 

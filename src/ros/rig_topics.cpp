@@ -4,6 +4,7 @@
 #include "dem_mobility/ConePenetration.h"
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 namespace {

@@ -18,6 +18,7 @@
 #include "dem_mobility/ros/conversions.h"
 #include "dem_mobility/ros/dem_visuals.h"
 #include "dem_mobility/ros/rig_topics.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 

@@ -12,6 +12,7 @@
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 #include "dem_mobility/ros/conversions.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 

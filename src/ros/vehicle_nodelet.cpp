@@ -23,6 +23,7 @@
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/ros/conversions.h"
 #include "dem_mobility/ros/vehicle_visuals.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 namespace {
@@ -63,10 +64,10 @@ class ExchangeTerrainPort final : public TerrainPort {
 /// The driver reached through the lock-step exchange.
 class ExchangeDriverPort final : public DriverPort {
  public:
-  explicit ExchangeDriverPort(std::unique_ptr<ExchangeClient<DriverInput, DriverCommand>> client)
+  explicit ExchangeDriverPort(std::unique_ptr<ExchangeClient<dem_mobility::DriverInput, dem_mobility::DriverCommand>> client)
       : client_(std::move(client)) {}
-  DriveCommand Exchange(const DriveInput& in) override {
-    auto req = boost::make_shared<DriverInput>();
+  core::DriverCommand Exchange(const core::DriverInput& in) override {
+    auto req = boost::make_shared<dem_mobility::DriverInput>();
     req->header.stamp = ros::Time(stamp_offset + in.time);
     ToMsg(in, req.get());
     try {
@@ -78,10 +79,10 @@ class ExchangeDriverPort final : public DriverPort {
   }
   void Leave(const std::string& why) { client_->Leave(why); }
   double stamp_offset = 0.0;  ///< simulation time of the driver's start
-  boost::shared_ptr<const DriverCommand> last_resp;
+  boost::shared_ptr<const dem_mobility::DriverCommand> last_resp;
 
  private:
-  std::unique_ptr<ExchangeClient<DriverInput, DriverCommand>> client_;
+  std::unique_ptr<ExchangeClient<dem_mobility::DriverInput, dem_mobility::DriverCommand>> client_;
 };
 
 /// A publisher that counts what it published (the bag test compares the counts).
@@ -140,7 +141,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
               nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches",
               "terrain", timing),
           world_frame_, DescribeTerrain(scene_.terrain_file));
-      driver_ = std::make_unique<ExchangeDriverPort>(std::make_unique<ExchangeClient<DriverInput, DriverCommand>>(
+      driver_ = std::make_unique<ExchangeDriverPort>(std::make_unique<ExchangeClient<dem_mobility::DriverInput, dem_mobility::DriverCommand>>(
           nh, transport, nh.resolveName("exchange/driver"), "exchange/driver_input", "exchange/driver_command", "driver",
           timing));
       NODELET_INFO("vehicle '%s' (%d bodies) on %s, grade %.2f deg, exchange over %s",
@@ -169,7 +170,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     add(&odom_, nh.advertise<nav_msgs::Odometry>("odom", q), "odom");
     add(&states_, nh.advertise<WheelStates>("wheel_states", q), "wheel_states");
     add(&wrenches_, nh.advertise<WheelWrenches>("wheel_wrenches", q), "wheel_wrenches");
-    add(&command_, nh.advertise<DriverCommand>("driver_command", q), "driver_command");
+    add(&command_, nh.advertise<dem_mobility::DriverCommand>("driver_command", q), "driver_command");
     add(&body_markers_, nh.advertise<visualization_msgs::MarkerArray>("vehicle/markers", q, true), "vehicle/markers");
     add(&live_markers_, nh.advertise<visualization_msgs::MarkerArray>("vehicle/forces", q), "vehicle/forces");
     add(&result_, nh.advertise<MobilityResult>("result", 1, true), "result");
@@ -217,7 +218,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   }
 
   // --- CoSimObserver
-  void OnStep(const VehicleCoSim& sim, const DriveCommand& /*cmd*/) override {
+  void OnStep(const VehicleCoSim& sim, const core::DriverCommand& /*cmd*/) override {
     const long k = sim.step();
     if (k % clock_every_ == 0) {
       rosgraph_msgs::Clock c;
@@ -340,7 +341,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   Counted clock_, tf_, tf_static_, odom_, states_, wrenches_, command_, body_markers_, live_markers_, result_;
   std::vector<Counted*> counted_;
   boost::shared_ptr<const WheelStates> logged_req_;
-  boost::shared_ptr<const DriverCommand> logged_cmd_;
+  boost::shared_ptr<const dem_mobility::DriverCommand> logged_cmd_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };

@@ -1,4 +1,5 @@
 #include "dem_mobility/ros/vehicle_visuals.h"
+#include "dem_mobility/ros/core_names.h"
 
 #include <algorithm>
 #include <cmath>

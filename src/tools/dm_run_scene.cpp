@@ -15,7 +15,7 @@
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/scenes/scene_registry.h"
 
-using namespace dem_mobility;
+using namespace dem_mobility::core;
 
 namespace {
 int Usage() {

@@ -13,7 +13,7 @@
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
 #include "dem_mobility/core/scenes/uniaxial_compression.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 namespace {
 
 const char* kScene = DM_CONFIG_DIR "/scenes/cone_penetrometer.yaml";
@@ -157,4 +157,4 @@ TEST(UniaxialCompression, DensityRisesWithPressureAndMostCompactionRemains) {
 }
 
 }  // namespace
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

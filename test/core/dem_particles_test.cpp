@@ -11,7 +11,7 @@
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_test_soils.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 namespace {
 
 using Eigen::Vector3d;
@@ -183,4 +183,4 @@ TEST(DemParticles, DissipationOfADampedCollisionIsTheKineticEnergyLost) {
 }
 
 }  // namespace
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

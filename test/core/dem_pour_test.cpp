@@ -5,7 +5,7 @@
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/scenes/dem_pour.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 namespace {
 
 TEST(DemPour, LidConsolidatesThePouredBed) {
@@ -30,4 +30,4 @@ TEST(DemPour, LidConsolidatesThePouredBed) {
 }
 
 }  // namespace
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

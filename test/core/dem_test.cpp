@@ -10,7 +10,7 @@
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_test_soils.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 namespace {
 
 using Eigen::Vector3d;
@@ -275,4 +275,4 @@ TEST(Dem, FastWallStrikesEveryParticleWithWallOnlyBuilds) {
 }
 
 }  // namespace
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -4,7 +4,7 @@
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/soil_law.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 inline SoilParams Nominal() { return SoilParams::Read(YamlReader::Load(DM_CONFIG_DIR "/soils/nominal_clay.yaml")); }
 
@@ -20,4 +20,4 @@ inline SoilParams Elastic(double damping_area) {
   return p;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -8,7 +8,7 @@
 #include "dem_mobility/core/common/rotation.h"
 #include "test_util.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 namespace {
 
 using Eigen::Vector3d;
@@ -129,4 +129,4 @@ TEST(Integrator, FreeFallIsExact) {
 }
 
 }  // namespace
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -5,7 +5,7 @@
 #include "dem_mobility/core/vehicle/driver.h"
 #include "dem_mobility/core/vehicle/powertrain.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 namespace {
 
 PowertrainParams Hmmwv() {
@@ -49,13 +49,13 @@ TEST(Driver, RequestsWotWhenTheCommandOutrunsTheVehicle) {
   EXPECT_DOUBLE_EQ(drv.SpeedCommand(10.0), 10.0);
   EXPECT_DOUBLE_EQ(drv.SpeedCommand(40.0), 25.0);
   // far behind the command at 125 rad/s: the request exceeds WOT, clamp to the table
-  const DriveCommand c = drv.Update(20.0, 1e-3, 5.0, 125.0);
+  const DriverCommand c = drv.Update(20.0, 1e-3, 5.0, 125.0);
   EXPECT_TRUE(c.wot_limited);
   EXPECT_DOUBLE_EQ(c.drive_torque, 1885.0);
   EXPECT_EQ(c.brake_effort, 0.0);
   // far ahead of the command: below the engine brake, the brakes take the rest
   SpeedDriver drv2(d, p, 4863.0, 0.485, 0.2);
-  const DriveCommand b = drv2.Update(5.0, 1e-3, 15.0, 150.0);
+  const DriverCommand b = drv2.Update(5.0, 1e-3, 15.0, 150.0);
   EXPECT_DOUBLE_EQ(b.drive_torque, -29.0);
   EXPECT_GT(b.brake_effort, 0.0);
 }
@@ -72,7 +72,7 @@ TEST(Driver, CommandIsClampedToTheTablesAtSeveralDriveShaftSpeeds) {
   } wot_rows[] = {{20.0, 6424.0}, {125.0, 1885.0}, {350.0, 685.0}};
   for (const auto& r : wot_rows) {
     SpeedDriver drv(d, p, 4863.0, 0.485, 0.2);
-    const DriveCommand c = drv.Update(20.0, 1e-3, 0.0, r.w);
+    const DriverCommand c = drv.Update(20.0, 1e-3, 0.0, r.w);
     EXPECT_DOUBLE_EQ(c.drive_torque, r.wot) << "w = " << r.w;
     EXPECT_TRUE(c.wot_limited);
   }
@@ -81,7 +81,7 @@ TEST(Driver, CommandIsClampedToTheTablesAtSeveralDriveShaftSpeeds) {
   } brake_rows[] = {{30.0, -176.0}, {300.0, -22.0}};
   for (const auto& r : brake_rows) {
     SpeedDriver drv(d, p, 4863.0, 0.485, 0.2);
-    const DriveCommand c = drv.Update(1.0, 1e-3, 20.0, r.w);
+    const DriverCommand c = drv.Update(1.0, 1e-3, 20.0, r.w);
     EXPECT_DOUBLE_EQ(c.drive_torque, r.eb) << "w = " << r.w;
     EXPECT_FALSE(c.wot_limited);
     EXPECT_GT(c.brake_effort, 0.0);
@@ -89,4 +89,4 @@ TEST(Driver, CommandIsClampedToTheTablesAtSeveralDriveShaftSpeeds) {
 }
 
 }  // namespace
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

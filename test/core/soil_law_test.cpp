@@ -8,7 +8,7 @@
 #include "dem_mobility/core/dem/soil_law.h"
 #include "dem_test_soils.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 namespace {
 
 
@@ -154,4 +154,4 @@ TEST(SoilLaw, BadSoilFileNamesTheFileAndKey) {
 }
 
 }  // namespace
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

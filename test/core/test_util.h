@@ -4,7 +4,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/multibody/multibody_system.h"
 
-namespace dem_mobility::test {
+namespace dem_mobility::core::test {
 
 inline RigidBody MakeBody(const std::string& name, double m, const Eigen::Vector3d& inertia,
                           const Eigen::Vector3d& x = Eigen::Vector3d::Zero()) {
@@ -28,4 +28,4 @@ inline PointJoint MakePoint(const MultibodySystem& s, int a, int b, const Eigen:
   return j;
 }
 
-}  // namespace dem_mobility::test
+}  // namespace dem_mobility::core::test

@@ -8,7 +8,7 @@
 #include "dem_mobility/core/vehicle/vehicle.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 namespace {
 
 MobilityRunParams Scene(double grade) {
@@ -150,4 +150,4 @@ TEST(Vehicle, TimeStepAboveTheCriticalOneIsRefused) {
 }
 
 }  // namespace
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -16,6 +16,7 @@
 #include "dem_mobility/core/vehicle/driver.h"
 #include "dem_mobility/core/mobility/mobility_run.h"
 #include "dem_mobility/ros/lockstep.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 
@@ -23,10 +24,10 @@ void ToMsg(const std::vector<WheelState>& s, WheelStates* m);
 void FromMsg(const WheelStates& m, std::vector<WheelState>* s);
 void ToMsg(const std::vector<WheelWrench>& w, WheelWrenches* m);
 void FromMsg(const WheelWrenches& m, std::vector<WheelWrench>* w);
-void ToMsg(const DriveInput& in, DriverInput* m);
-DriveInput FromMsg(const DriverInput& m);
-void ToMsg(const DriveCommand& c, DriverCommand* m);
-DriveCommand FromMsg(const DriverCommand& m);
+void ToMsg(const core::DriverInput& in, dem_mobility::DriverInput* m);
+core::DriverInput FromMsg(const dem_mobility::DriverInput& m);
+void ToMsg(const core::DriverCommand& c, dem_mobility::DriverCommand* m);
+core::DriverCommand FromMsg(const dem_mobility::DriverCommand& m);
 
 /// The scene every nodelet of a run reads, from the run's namespace `nh`: parameter `scene` (the
 /// file) and the overrides under `override/` (e.g. override/grade_deg: 12, override/driver/kp: 4000;

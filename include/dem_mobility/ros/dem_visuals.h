@@ -11,6 +11,7 @@
 #include <visualization_msgs/Marker.h>
 
 #include "dem_mobility/core/dem/dem_system.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 

@@ -9,6 +9,7 @@
 #include <ros/ros.h>
 
 #include "dem_mobility/core/scenes/soil_rig.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 

@@ -10,6 +10,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "dem_mobility/core/cosim/vehicle_cosim.h"
+#include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {
 

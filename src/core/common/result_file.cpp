@@ -5,7 +5,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 ResultFile::ResultFile(const std::string& scene_file, const std::string& kind)
     : scene_(scene_file), kind_(kind), body_(YAML::NodeType::Map) {}
@@ -72,4 +72,4 @@ void ResultFile::CheckWritable(const std::string& path, const std::string& what)
     throw ConfigError((what.empty() ? "" : what + ": ") + path + ": cannot write the result file here");
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

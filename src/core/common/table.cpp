@@ -5,7 +5,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 Table1D::Table1D(std::vector<double> x, std::vector<double> y, const std::string& what)
     : x_(std::move(x)), y_(std::move(y)) {
@@ -53,4 +53,4 @@ double Table1D::MaxSlope() const {
   return s;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -4,7 +4,7 @@
 #include <fstream>
 #include <sstream>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 namespace {
 std::string Show(const YAML::Node& n) {
@@ -227,4 +227,4 @@ void YamlReader::Finish() const {
   if (!unknown.empty()) Fail("", "unknown key(s): " + unknown);
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -6,7 +6,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, DriverPort& driver, CoSimObserver* observer) {
   const MobilityRunParams& p = sim.params();
@@ -23,7 +23,7 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
   const long run_steps = std::lround(p.duration / dt);
   const long sample_every = std::max(1L, std::lround(1.0 / (p.sample_rate * dt)));
   const long control_every = std::max(1L, std::lround(p.driver.control_period / dt));
-  DriveCommand cmd;
+  DriverCommand cmd;
   cmd.brake_effort = 1.0;  // settling: brakes on, no drive
   double x0 = 0.0;
   try {
@@ -38,7 +38,7 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
         const double v = veh.ForwardSpeed();
         const double w_ds = veh.DriveShaftSpeed();
         if (k % control_every == 0) {
-          DriveInput in;
+          DriverInput in;
           in.step = sim.step();
           in.time = t;
           in.period = control_every * dt;
@@ -77,4 +77,4 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
   return r;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

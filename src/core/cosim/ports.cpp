@@ -3,7 +3,7 @@
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 void LocalTerrainPort::Exchange(long step, double t, double dt, const std::vector<WheelState>& states,
                                 std::vector<WheelWrench>* wrenches) {
@@ -18,8 +18,8 @@ SceneDriver::SceneDriver(const DriverParams& p, const VehicleSpec& vehicle)
     : powertrain_(vehicle.powertrain),
       driver_(p, powertrain_, vehicle.TotalMass(), vehicle.wheel_radius(), vehicle.driveline_reduction()) {}
 
-DriveCommand SceneDriver::Exchange(const DriveInput& in) {
+DriverCommand SceneDriver::Exchange(const DriverInput& in) {
   return driver_.Update(in.time, in.period, in.forward_speed, in.drive_shaft_speed);
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -4,7 +4,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 Eigen::Vector3d VehicleCoSim::GradeGravity(double deg) {
   const double a = deg * M_PI / 180.0;
@@ -84,4 +84,4 @@ void VehicleCoSim::Step(TerrainPort& terrain) {
   sys.EndStep();
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

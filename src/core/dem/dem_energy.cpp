@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 double PairEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists, int i, int k) {
   // the elastic energy stored in one contact: its normal branches (repulsion, and the adhesion
@@ -44,4 +44,4 @@ double ParticleEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const Ne
   return u;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -4,7 +4,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
@@ -102,4 +102,4 @@ DemWall MakeRodWall(const std::string& name, double radius, double length, int s
   return w;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

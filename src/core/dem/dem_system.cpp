@@ -7,7 +7,7 @@
 #include "dem_mobility/core/dem/dem_watchdogs.h"
 #include "dem_mobility/core/dem/pair_sweep.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
@@ -206,4 +206,4 @@ Vector3d DemSystem::Momentum() const {
   return p;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

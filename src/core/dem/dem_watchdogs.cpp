@@ -6,7 +6,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 TimeStepLimit DemCriticalTimeStep(const SoilParams& soil, double mass, int max_coordination) {
   const double z = max_coordination;
@@ -57,4 +57,4 @@ void CheckParticleOverlaps(const ParticleStore& ps, double diameter, double max_
                                            ps.overlap[i] / diameter, " of the diameter (limit ", max_overlap, ")"));
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

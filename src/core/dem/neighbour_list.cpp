@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
@@ -272,4 +272,4 @@ size_t NeighbourList::MemoryBytes() const {
   return b;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
@@ -83,4 +83,4 @@ void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threa
   }
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

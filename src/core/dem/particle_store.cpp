@@ -2,7 +2,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 int ParticleStore::LiveSlot(int id) const {
   DM_THROW_UNLESS(id >= 0 && id < size() && alive(id), "particle ", id, " is not a live particle");
@@ -86,4 +86,4 @@ size_t ParticleStore::MemoryBytes() const {
          bytes(ids_) + bytes(free_slots_);
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

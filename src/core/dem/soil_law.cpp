@@ -6,7 +6,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 SoilParams SoilParams::Read(const YamlReader& y) {
   SoilParams p;
@@ -63,4 +63,4 @@ double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_
   return delta_p;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -7,7 +7,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/geometry/trimesh.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
@@ -49,8 +49,8 @@ void WallContacts::ClearSlot(int s) {
 }
 
 void WallContacts::PermuteSlots(const std::vector<int>& order) {
-  dem_mobility::PermuteSlots(&hist_, order, walls_.size());
-  dem_mobility::PermuteSlots(&touching_, order, walls_.size());
+  core::PermuteSlots(&hist_, order, walls_.size());
+  core::PermuteSlots(&touching_, order, walls_.size());
 }
 
 void WallContacts::UpdateVertices() {
@@ -219,4 +219,4 @@ size_t WallContacts::MemoryBytes() const {
   return bytes(hist_) + bytes(touching_) + bytes(tri_start_) + bytes(tri_of_slot_) + bytes(chunk_);
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -8,7 +8,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector2d;
 using Eigen::Vector3d;
@@ -149,4 +149,4 @@ double TerrainMesh::MaxHeight(const Vector2d& lo, const Vector2d& hi) const {
   return z;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

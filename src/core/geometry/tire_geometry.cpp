@@ -4,7 +4,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 TireGeometry TireGeometry::Make(double radius, double width, double shoulder_radius, int n_circ, int n_lat) {
   DM_THROW_UNLESS(radius > 0 && width > 0, "tire: radius and width must be positive");
@@ -44,4 +44,4 @@ TireGeometry TireGeometry::Make(double radius, double width, double shoulder_rad
   return g;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -8,7 +8,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector2d;
 using Eigen::Vector3d;
@@ -55,4 +55,4 @@ Vector3d ClosestPointOnTriangle(const Vector3d& p, const Vector3d& a, const Vect
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

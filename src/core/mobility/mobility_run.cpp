@@ -8,7 +8,7 @@
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
   MobilityRunParams p;
@@ -122,4 +122,4 @@ void WriteMobilityHistory(const MobilityRunResult& r, const std::string& path) {
         << s.drive_torque << "," << s.brake_effort << "," << s.wot_limited << "\n";
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

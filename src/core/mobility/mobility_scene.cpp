@@ -2,7 +2,7 @@
 
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 MobilityRun::MobilityRun(const MobilityRunParams& p)
     : spec_(VehicleSpec::Load(p.vehicle_file)),
@@ -17,4 +17,4 @@ MobilityRunResult MobilityRun::Run(CoSimObserver* observer) {
   return RunCoSimulation(sim_, port_, driver_, observer);
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

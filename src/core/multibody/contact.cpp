@@ -8,7 +8,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
@@ -194,4 +194,4 @@ int TireContact::SimultaneousVertices() const {
   return std::min(tire->n_circ, cols) * tire->n_lat;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

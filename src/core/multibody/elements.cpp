@@ -7,7 +7,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
@@ -323,4 +323,4 @@ void AxisTorque::Apply(Bodies& bodies) const {
   bodies[housing].torque -= t;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -8,7 +8,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/rotation.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
@@ -194,4 +194,4 @@ Vector3d MultibodySystem::CenterOfMass() const {
   return c / TotalMass();
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -5,7 +5,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 namespace {
 double Interpolate(const std::vector<double>& x, const std::vector<double>& y, double v) {
@@ -54,4 +54,4 @@ double CiCalibration::ConeIndex(double fac) const {
   return Interpolate(f, ci, fac);
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

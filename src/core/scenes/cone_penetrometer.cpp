@@ -9,7 +9,7 @@
 #include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/scenes/soil_prep.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector2d;
 using Eigen::Vector3d;
@@ -388,4 +388,4 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
 
 ResultFile ConePenetrometer::Report() const { return ConeResultFile(Result(), p_); }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -11,7 +11,7 @@
 #include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/scenes/soil_prep.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
@@ -115,4 +115,4 @@ ResultFile DemPourResultFile(const DemPourResult& r, const DemPourParams& p) {
   return f;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

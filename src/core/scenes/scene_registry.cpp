@@ -12,7 +12,7 @@
 #include "dem_mobility/core/scenes/dem_pour.h"
 #include "dem_mobility/core/scenes/uniaxial_compression.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 namespace {
 
 /// Prints a progress line at most every `period` seconds of wall time.
@@ -44,7 +44,7 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
   class Progress final : public CoSimObserver {
    public:
     explicit Progress(double duration) : duration_(duration) {}
-    void OnStep(const VehicleCoSim& sim, const DriveCommand&) override {
+    void OnStep(const VehicleCoSim& sim, const DriverCommand&) override {
       if ((sim.step() & 255) != 0 || !ticker_.Due()) return;
       const double t = std::max(0.0, sim.driver_time()), rtf = sim.time() / std::max(ticker_.Elapsed(), 1e-9);
       std::printf("  t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s\n", t, duration_,
@@ -143,4 +143,4 @@ const SceneKind& FindSceneKind(const YamlReader& y) {
   y.Fail("scene", "unknown scene '" + kind + "' (known: " + known + ")");
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

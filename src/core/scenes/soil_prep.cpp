@@ -8,7 +8,7 @@
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_shapes.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector2d;
 using Eigen::Vector3d;
@@ -190,4 +190,4 @@ double TopParticle(const DemSystem& s) {
   return top;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -4,7 +4,7 @@
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 void RunSoilRig(SoilRig& rig, const std::function<void(const SoilRig&)>& progress, long every) {
   try {
@@ -41,4 +41,4 @@ std::unique_ptr<SoilRig> MakeSoilRig(const YamlReader& y) {
   y.Fail("scene", "'" + kind + "' is not a soil rig (rigs: " + known + ")");
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -10,7 +10,7 @@
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/scenes/soil_prep.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
@@ -124,4 +124,4 @@ ResultFile CompressionResultFile(const CompressionResult& r, const CompressionPa
   return f;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

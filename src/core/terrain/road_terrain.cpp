@@ -8,7 +8,7 @@
 #include "dem_mobility/core/geometry/terrain_mesh.h"
 #include "dem_mobility/core/multibody/contact.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 namespace {
 
 class RoadTerrain final : public TerrainModel {
@@ -94,4 +94,4 @@ std::unique_ptr<TerrainModel> MakeRoadTerrain(const YamlReader& y, const Terrain
   return std::make_unique<RoadTerrain>(y, vehicle);
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -6,7 +6,7 @@
 #include "dem_mobility/core/terrain/road_terrain.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 const std::vector<TerrainKind>& TerrainKinds() {
   static const std::vector<TerrainKind> kinds = {
@@ -38,4 +38,4 @@ TerrainDescription DescribeTerrain(const std::string& terrain_file) {
   return FindKind(y).describe(y);
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

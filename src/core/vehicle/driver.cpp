@@ -6,7 +6,7 @@
 
 #include "dem_mobility/core/common/yaml_reader.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 DriverParams DriverParams::Read(const YamlReader& y) {
   DriverParams p;
@@ -26,8 +26,8 @@ SpeedDriver::SpeedDriver(const DriverParams& p, const PowertrainParams& pt, doub
 
 double SpeedDriver::SpeedCommand(double t) const { return std::min(p_.v_max, p_.accel * std::max(0.0, t)); }
 
-DriveCommand SpeedDriver::Update(double t, double dt, double v, double w_ds) {
-  DriveCommand c;
+DriverCommand SpeedDriver::Update(double t, double dt, double v, double w_ds) {
+  DriverCommand c;
   const double wot = pt_.wot(w_ds), eb = pt_.engine_brake(w_ds);
   if (p_.full_throttle) {
     c.speed_command = std::numeric_limits<double>::infinity();
@@ -53,4 +53,4 @@ DriveCommand SpeedDriver::Update(double t, double dt, double v, double w_ds) {
   return c;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -5,7 +5,7 @@
 
 #include "dem_mobility/core/common/yaml_reader.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 PowertrainParams PowertrainParams::Read(const YamlReader& y) {
   PowertrainParams p;
@@ -42,4 +42,4 @@ double PowertrainParams::BrakeTorque(double effort, double angle, double w_rel, 
   return t;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

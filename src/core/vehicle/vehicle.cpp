@@ -6,7 +6,7 @@
 
 #include "dem_mobility/core/common/error.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
@@ -69,4 +69,4 @@ TimeStepLimit Vehicle::WheelContactLimit(double stiffness, double damping) const
   return lim;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

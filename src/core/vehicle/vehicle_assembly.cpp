@@ -7,7 +7,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/vehicle/vehicle.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
@@ -329,4 +329,4 @@ std::unique_ptr<Vehicle> Vehicle::Build(const VehicleSpec& spec, const Vector3d&
   return v;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

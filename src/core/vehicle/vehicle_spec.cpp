@@ -5,7 +5,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
@@ -242,4 +242,4 @@ double VehicleSpec::TotalMass() const {
   return m;
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 struct AsperityFriction {
   double mu = 0.0;        ///< friction coefficient
@@ -46,4 +46,4 @@ struct AsperityFriction {
   }
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

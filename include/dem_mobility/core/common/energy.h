@@ -1,7 +1,7 @@
 // Energy bookkeeping, the same report for the multibody system and the DEM particles.
 #pragma once
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 struct EnergyReport {
   double kinetic = 0.0;
@@ -14,4 +14,4 @@ struct EnergyReport {
   double dissipated = 0.0;     ///< wall_work + exchanged - (Total() - Total() at the start)
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// A user-facing input error: bad configuration, nonsense parameter, unstable time step.
 class ConfigError : public std::runtime_error {
@@ -29,18 +29,18 @@ std::string Concat(const Args&... args) {
 }
 }  // namespace detail
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core
 
 /// Checks user input; always on, also in Release builds.
 #define DM_THROW_UNLESS(cond, ...)                                                  \
   do {                                                                              \
-    if (!(cond)) throw ::dem_mobility::ConfigError(::dem_mobility::detail::Concat(__VA_ARGS__)); \
+    if (!(cond)) throw ::dem_mobility::core::ConfigError(::dem_mobility::core::detail::Concat(__VA_ARGS__)); \
   } while (0)
 
 /// Checks an internal invariant; always on.
 #define DM_DEMAND(cond)                                                             \
   do {                                                                              \
     if (!(cond))                                                                    \
-      throw std::logic_error(::dem_mobility::detail::Concat("internal error: ", #cond, \
+      throw std::logic_error(::dem_mobility::core::detail::Concat("internal error: ", #cond, \
                                                             " at ", __FILE__, ":", __LINE__)); \
   } while (0)

@@ -9,7 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class ResultFile {
  public:
@@ -46,4 +46,4 @@ class ResultFile {
   YAML::Node body_;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

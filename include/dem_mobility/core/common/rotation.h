@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 inline Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
@@ -53,4 +53,4 @@ inline void Reorthonormalize(Eigen::Matrix3d& r) {
   r = r * (1.5 * Eigen::Matrix3d::Identity() - 0.5 * r.transpose() * r);
 }
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

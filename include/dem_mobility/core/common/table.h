@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// y(x) by linear interpolation between points with strictly increasing x; held constant outside.
 class Table1D {
@@ -27,4 +27,4 @@ class Table1D {
   std::vector<double> x_, y_;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -4,7 +4,7 @@
 
 #include <string>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// Critical explicit step of a damped oscillator: (2/omega)(sqrt(1+zeta^2) - zeta); infinite for
 /// omega <= 0.
@@ -17,4 +17,4 @@ struct TimeStepLimit {
   std::string detail;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

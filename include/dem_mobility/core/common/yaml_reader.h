@@ -13,7 +13,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/table.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// One map (or sequence element) of a YAML document, with the file it came from and its key path.
 ///
@@ -79,4 +79,4 @@ class YamlReader {
   std::shared_ptr<std::set<std::string>> used_;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

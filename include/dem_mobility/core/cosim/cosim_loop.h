@@ -6,14 +6,14 @@
 #include "dem_mobility/core/cosim/vehicle_cosim.h"
 #include "dem_mobility/core/mobility/mobility_run.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// What a run reports as it goes (the vehicle nodelet publishes from it; the runner prints).
 class CoSimObserver {
  public:
   virtual ~CoSimObserver() = default;
   /// After the opening exchange and after every step (the command in force is `cmd`).
-  virtual void OnStep(const VehicleCoSim& /*sim*/, const DriveCommand& /*cmd*/) {}
+  virtual void OnStep(const VehicleCoSim& /*sim*/, const DriverCommand& /*cmd*/) {}
   /// Polled every step: true stops the run (interrupted).
   virtual bool StopRequested() { return false; }
 };
@@ -25,4 +25,4 @@ class CoSimObserver {
 MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, DriverPort& driver,
                                   CoSimObserver* observer);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

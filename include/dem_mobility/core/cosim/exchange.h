@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// The wheels, in the order of every exchange, message and result: front left, front right, rear
 /// left, rear right.
@@ -45,7 +45,7 @@ struct TerrainDescription {
 };
 
 /// Vehicle -> driver at every control step.
-struct DriveInput {
+struct DriverInput {
   long step = 0;                  ///< vehicle step index
   double time = 0.0;              ///< since the driver's start [s]
   double period = 0.0;            ///< control period [s]
@@ -53,4 +53,4 @@ struct DriveInput {
   double drive_shaft_speed = 0.0; ///< [rad/s]
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -11,7 +11,7 @@
 #include "dem_mobility/core/cosim/exchange.h"
 #include "dem_mobility/core/vehicle/driver.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class TerrainModel;
 struct VehicleSpec;
@@ -32,7 +32,7 @@ class TerrainPort {
 class DriverPort {
  public:
   virtual ~DriverPort() = default;
-  virtual DriveCommand Exchange(const DriveInput& in) = 0;
+  virtual DriverCommand Exchange(const DriverInput& in) = 0;
 };
 
 /// A terrain model called directly (same process, same thread): synchronize, wrenches, advance.
@@ -52,11 +52,11 @@ class LocalTerrainPort final : public TerrainPort {
 class SceneDriver final : public DriverPort {
  public:
   SceneDriver(const DriverParams& p, const VehicleSpec& vehicle);
-  DriveCommand Exchange(const DriveInput& in) override;
+  DriverCommand Exchange(const DriverInput& in) override;
 
  private:
   PowertrainParams powertrain_;  ///< the driver's engine curves (SpeedDriver refers to them)
   SpeedDriver driver_;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -11,7 +11,7 @@
 #include "dem_mobility/core/vehicle/vehicle.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class VehicleCoSim {
  public:
@@ -53,4 +53,4 @@ class VehicleCoSim {
   std::vector<WheelWrench> wrenches_;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -10,7 +10,7 @@
 #include "dem_mobility/core/dem/particle_store.h"
 #include "dem_mobility/core/dem/soil_law.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// What the energy sums need besides the particles and their lists.
 struct DemEnergyTerms {
@@ -34,4 +34,4 @@ struct DemLedger {
   double wall_power = 0.0;  ///< the walls' power at the last force evaluation
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

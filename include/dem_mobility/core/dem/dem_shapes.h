@@ -8,7 +8,7 @@
 
 #include "dem_mobility/core/dem/dem_system.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// An open box [0, length] x [0, width] x [0, height]: a floor and four sides, each a flat wall
 /// (floor, x0, x1, y0, y1).
@@ -28,4 +28,4 @@ DemWall MakeConeWall(const std::string& name, double base_radius, double length,
 /// A closed vertical rod (a prism of `segments` sides, capped) from z = 0 to `length` (convex).
 DemWall MakeRodWall(const std::string& name, double radius, double length, int segments);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -30,7 +30,7 @@
 #include "dem_mobility/core/dem/soil_law.h"
 #include "dem_mobility/core/dem/wall_contacts.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 struct DemSettings {
   double skin = 0.1;            ///< Verlet skin as a fraction of the diameter
@@ -128,4 +128,4 @@ class DemSystem {
   DemLedger ledger_;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

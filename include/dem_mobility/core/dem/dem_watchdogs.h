@@ -6,7 +6,7 @@
 #include "dem_mobility/core/dem/particle_store.h"
 #include "dem_mobility/core/dem/soil_law.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// The stiffest branch (repulsion k_n or the anchor spring k_t; the adhesion ramp f_max / peak
 /// where it is stiffer) acting from `max_coordination` neighbours at once on a particle of `mass`.
@@ -18,4 +18,4 @@ void CheckParticleStates(const ParticleStore& ps, double dt, double half_skin, l
 /// An overlap beyond `max_overlap` diameters, or a non-finite force.
 void CheckParticleOverlaps(const ParticleStore& ps, double diameter, double max_overlap, long step, double time);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

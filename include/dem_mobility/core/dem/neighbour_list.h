@@ -21,7 +21,7 @@
 #include "dem_mobility/core/dem/particle_store.h"
 #include "dem_mobility/core/dem/soil_law.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class NeighbourList {
  public:
@@ -104,4 +104,4 @@ class NeighbourList {
   std::vector<std::vector<int>> slab_added_;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

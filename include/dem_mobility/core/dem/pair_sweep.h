@@ -8,11 +8,11 @@
 #include "dem_mobility/core/dem/particle_store.h"
 #include "dem_mobility/core/dem/soil_law.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// Adds the pair forces to ps->f (set beforehand to the weights) and records each particle's
 /// largest repulsion, tension and overlap (reset beforehand); updates the contact histories.
 void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
                 NeighbourList* lists);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

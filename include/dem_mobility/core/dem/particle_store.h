@@ -8,7 +8,7 @@
 #include <limits>
 #include <vector>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// What a slot holds.
 enum class SlotState : unsigned char {
@@ -92,4 +92,4 @@ class ParticleStore {
   int removed_ = 0;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -16,7 +16,7 @@
 #include "dem_mobility/core/common/asperity_friction.h"
 #include "dem_mobility/core/common/table.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class YamlReader;
 
@@ -125,4 +125,4 @@ double MaxAdhesionForce(const SoilParams& p, double delta_p);
 double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double max_tension,
                                 double dt);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

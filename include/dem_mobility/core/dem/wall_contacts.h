@@ -20,7 +20,7 @@
 #include "dem_mobility/core/dem/soil_law.h"
 #include "dem_mobility/core/geometry/trimesh.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// A rigid triangle mesh the particles touch: a container side, a lid, a cone, a wheel. Its pose
 /// and velocity are set from outside (static, prescribed motion, or driven by a multibody body);
@@ -117,4 +117,4 @@ class WallContacts {
   std::vector<WallSum> chunk_;                ///< per chunk of slots and wall
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -6,7 +6,7 @@
 
 #include "dem_mobility/core/geometry/trimesh.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// A static terrain surface: a triangle mesh that faces up (+z of its frame), with a uniform grid
 /// over x-y so that a point query only touches the triangles of one cell. Penetration is measured
@@ -53,4 +53,4 @@ class TerrainMesh {
   std::vector<Eigen::Vector4d> cell_plane_;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

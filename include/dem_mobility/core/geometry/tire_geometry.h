@@ -7,7 +7,7 @@
 
 #include "dem_mobility/core/geometry/trimesh.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// Geometry of a rigid tire: a triangle mesh built as rings of vertices around the spin axis
 /// (body y), so that only the columns facing the ground need testing.
@@ -21,4 +21,4 @@ struct TireGeometry {
   Eigen::Vector3d Vertex(int col, int j) const { return mesh.vertices[col * n_lat + j]; }
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// A plain triangle mesh (vertices and faces, counter-clockwise seen from outside).
 struct TriMesh {
@@ -23,4 +23,4 @@ TriMesh MakeFlatRoad(double x0, double length, double width, double cell);
 Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                        const Eigen::Vector3d& c);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -11,7 +11,7 @@
 
 #include "dem_mobility/core/vehicle/driver.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class ResultFile;
 class YamlReader;
@@ -79,4 +79,4 @@ ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParam
 /// Writes the history as CSV to `path`.
 void WriteMobilityHistory(const MobilityRunResult& r, const std::string& path);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -7,7 +7,7 @@
 #include "dem_mobility/core/cosim/cosim_loop.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class MobilityRun {
  public:
@@ -28,4 +28,4 @@ class MobilityRun {
   VehicleCoSim sim_;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -11,7 +11,7 @@
 #include "dem_mobility/core/geometry/terrain_mesh.h"
 #include "dem_mobility/core/geometry/tire_geometry.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class YamlReader;
 
@@ -82,4 +82,4 @@ struct TireContact {
   int SimultaneousVertices() const;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -12,7 +12,7 @@
 #include "dem_mobility/core/common/time_step.h"
 #include "dem_mobility/core/multibody/rigid_body.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 using Bodies = std::vector<RigidBody>;
 
@@ -150,4 +150,4 @@ struct AxisTorque {
   void Apply(Bodies& bodies) const;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

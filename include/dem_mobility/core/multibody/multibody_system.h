@@ -12,7 +12,7 @@
 #include "dem_mobility/core/multibody/elements.h"
 #include "dem_mobility/core/multibody/rigid_body.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// Bodies and force elements integrated by velocity Verlet, the explicit member of the trapezoidal
 /// family (paper eq. 3-5): the velocity update is eq. 3a/4a, positions use x + dt v + dt^2/2 a, and
@@ -83,4 +83,4 @@ class MultibodySystem {
   bool finalized_ = false;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -4,7 +4,7 @@
 #include <Eigen/Core>
 #include <string>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// Lumped mass at the centre of mass, inertia in the body frame (so it is constant, eq. 2).
 /// Translational state in the global frame, angular velocity in the body frame.
@@ -51,4 +51,4 @@ struct RigidBody {
   Eigen::Vector3d AngularMomentumWorld() const { return R * (inertia * w); }
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class YamlReader;
 
@@ -26,4 +26,4 @@ struct CiCalibration {
   double ConeIndex(double f) const;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

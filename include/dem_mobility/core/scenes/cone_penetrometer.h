@@ -22,7 +22,7 @@
 #include "dem_mobility/core/scenes/soil_prep.h"
 #include "dem_mobility/core/scenes/soil_rig.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class YamlReader;
 
@@ -162,4 +162,4 @@ class ConePenetrometer final : public SoilRig {
 /// The result file (the one schema: scene, kind, status, error, then the figures and the CI history).
 ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

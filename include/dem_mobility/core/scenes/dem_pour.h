@@ -8,7 +8,7 @@
 
 #include "dem_mobility/core/dem/dem_system.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class ResultFile;
 class YamlReader;
@@ -46,4 +46,4 @@ DemPourResult RunDemPour(const DemPourParams& p, std::unique_ptr<DemSystem>* kee
 /// The result file (the one schema: scene, kind, status, error, then the figures).
 ResultFile DemPourResultFile(const DemPourResult& r, const DemPourParams& p);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

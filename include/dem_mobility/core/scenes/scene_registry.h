@@ -10,7 +10,7 @@
 
 #include "dem_mobility/core/common/result_file.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class YamlReader;
 
@@ -31,4 +31,4 @@ const std::vector<SceneKind>& SceneKinds();
 /// The kind of a scene file (its `scene:` key); ConfigError listing the known kinds otherwise.
 const SceneKind& FindSceneKind(const YamlReader& scene_file);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

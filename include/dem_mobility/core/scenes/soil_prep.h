@@ -13,7 +13,7 @@
 
 #include "dem_mobility/core/dem/dem_system.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class YamlReader;
 
@@ -129,4 +129,4 @@ SoilParams ReadSceneSoil(const YamlReader& y, const std::string& kind);
 /// Height of the highest particle centre (0 without particles).
 double TopParticle(const DemSystem& s);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

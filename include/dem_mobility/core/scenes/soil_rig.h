@@ -11,7 +11,7 @@
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/dem/dem_system.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class YamlReader;
 
@@ -52,4 +52,4 @@ bool IsSoilRigScene(const std::string& kind);
 /// Builds the rig of a scene file; ConfigError naming the file and key for bad input.
 std::unique_ptr<SoilRig> MakeSoilRig(const YamlReader& scene_file);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -8,7 +8,7 @@
 
 #include "dem_mobility/core/dem/dem_system.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class ResultFile;
 class YamlReader;
@@ -47,4 +47,4 @@ CompressionResult RunUniaxialCompression(const CompressionParams& p);
 /// The result file (the one schema: scene, kind, status, error, then the figures).
 ResultFile CompressionResultFile(const CompressionResult& r, const CompressionParams& p);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -7,9 +7,9 @@
 
 #include "dem_mobility/core/terrain/terrain_model.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 std::unique_ptr<TerrainModel> MakeRoadTerrain(const YamlReader& y, const TerrainVehicle& vehicle);
 TerrainDescription DescribeRoadTerrain(const YamlReader& y);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

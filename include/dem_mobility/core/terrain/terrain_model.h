@@ -15,7 +15,7 @@
 #include "dem_mobility/core/geometry/tire_geometry.h"
 #include "dem_mobility/core/geometry/trimesh.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class YamlReader;
 
@@ -58,4 +58,4 @@ std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, 
 /// What `terrain_file` describes (model and cone index), without building it.
 TerrainDescription DescribeTerrain(const std::string& terrain_file);
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

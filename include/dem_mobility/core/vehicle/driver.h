@@ -5,7 +5,7 @@
 
 #include "dem_mobility/core/vehicle/powertrain.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class YamlReader;
 
@@ -20,7 +20,7 @@ struct DriverParams {
 };
 
 /// Command produced each step.
-struct DriveCommand {
+struct DriverCommand {
   double speed_command = 0.0;   ///< [m/s]
   double torque_request = 0.0;  ///< drive-shaft torque asked for [N m] (before the engine clamp)
   double drive_torque = 0.0;    ///< after the clamp between engine-brake and WOT curves [N m]
@@ -37,7 +37,7 @@ class SpeedDriver {
   /// Speed command of the profile at time t (from the driver's start).
   double SpeedCommand(double t) const;
   /// Advances the controller by dt at time t with forward speed v and drive-shaft speed w_ds.
-  DriveCommand Update(double t, double dt, double v, double w_ds);
+  DriverCommand Update(double t, double dt, double v, double w_ds);
 
  private:
   DriverParams p_;
@@ -46,4 +46,4 @@ class SpeedDriver {
   double integral_ = 0.0;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

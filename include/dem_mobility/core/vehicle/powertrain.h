@@ -4,7 +4,7 @@
 
 #include "dem_mobility/core/common/table.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 class YamlReader;
 
@@ -28,4 +28,4 @@ struct PowertrainParams {
   double BrakeTorque(double effort, double angle, double w_rel, double* anchor) const;
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

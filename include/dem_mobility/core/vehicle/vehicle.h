@@ -10,7 +10,7 @@
 #include "dem_mobility/core/vehicle/powertrain.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// Wheel order everywhere (kWheelNames, cosim/exchange.h): front left, front right, rear left, rear right.
 enum WheelIndex { kFrontLeft = 0, kFrontRight = 1, kRearLeft = 2, kRearRight = 3 };
@@ -82,4 +82,4 @@ class Vehicle {
   std::array<WheelWrench, 4> wrench_{};
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core

@@ -9,7 +9,7 @@
 #include "dem_mobility/core/geometry/tire_geometry.h"
 #include "dem_mobility/core/vehicle/powertrain.h"
 
-namespace dem_mobility {
+namespace dem_mobility::core {
 
 /// Stiffness and damping of a penalty element (eq. 6-7): [N/m, N s/m] or [N m/rad, N m s/rad].
 struct Penalty {
@@ -121,4 +121,4 @@ struct VehicleSpec {
   double driveline_reduction() const { return driveline.final_drive_ratio; }
 };
 
-}  // namespace dem_mobility
+}  // namespace dem_mobility::core
