@@ -44,17 +44,20 @@ class SoilRigNodelet : public nodelet::Nodelet {
     tools_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/tools", 10);
     cloud_ = nh.advertise<sensor_msgs::PointCloud2>("terrain/particles", 2);
     section_ = nh.advertise<sensor_msgs::PointCloud2>("terrain/particles_section", 2);
-    std::string kind = "?";
+    std::string kind;
     try {
       const YamlReader scene = LoadSceneFile(nh);
       scene_file_ = scene.file();
       kind = scene.String("scene");
-      topics_ = MakeRigTopics(kind);
-      topics_->Advertise(nh);
+      // the rig's result topic first, so that a rig that cannot start still reports why
+      if (IsSoilRigScene(kind)) {
+        topics_ = MakeRigTopics(kind);
+        topics_->Advertise(nh);
+      }
       if (!(cloud_rate_ > 0.0)) throw ConfigError("parameter " + pnh.resolveName("cloud_rate") + " must be > 0 Hz");
       if (!(clock_rate_ > 0.0)) throw ConfigError("parameter " + pnh.resolveName("clock_rate") + " must be > 0 Hz");
       ResultFile::CheckWritable(result_file_, "parameter " + pnh.resolveName("result_file"));
-      rig_ = MakeSoilRig(scene);
+      rig_ = MakeSoilRig(scene);  // ConfigError naming the file and key for a scene that is no rig
     } catch (const std::exception& e) {
       NODELET_FATAL("%s", e.what());
       if (topics_) topics_->PublishSetupError(e.what());

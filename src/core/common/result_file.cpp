@@ -10,12 +10,17 @@ namespace dem_mobility::core {
 ResultFile::ResultFile(const std::string& scene_file, const std::string& kind)
     : scene_(scene_file), kind_(kind), body_(YAML::NodeType::Map) {}
 
+bool ResultFile::Reserved(const std::string& key) {
+  return key == "scene" || key == "kind" || key == "status" || key == "error";
+}
+
 void ResultFile::SetStatus(const std::string& status, const std::string& error) {
   status_ = status;
   error_ = error;
 }
 
 ResultFile& ResultFile::SetFlow(const std::string& key, const std::vector<double>& values) {
+  DM_DEMAND(!Reserved(key));
   YAML::Node n(YAML::NodeType::Sequence);
   for (double v : values) n.push_back(v);
   n.SetStyle(YAML::EmitterStyle::Flow);
@@ -24,6 +29,7 @@ ResultFile& ResultFile::SetFlow(const std::string& key, const std::vector<double
 }
 
 ResultFile& ResultFile::SetCounts(const std::string& key, const std::vector<std::pair<std::string, long>>& counts) {
+  DM_DEMAND(!Reserved(key));
   YAML::Node n(YAML::NodeType::Map);
   for (const auto& [name, count] : counts) n[name] = count;
   body_[key] = n;
@@ -32,6 +38,7 @@ ResultFile& ResultFile::SetCounts(const std::string& key, const std::vector<std:
 
 ResultFile& ResultFile::SetColumns(const std::string& key,
                                    const std::vector<std::pair<std::string, std::vector<double>>>& cols) {
+  DM_DEMAND(!Reserved(key));
   YAML::Node n(YAML::NodeType::Map);
   for (const auto& [name, values] : cols) {
     YAML::Node c(YAML::NodeType::Sequence);

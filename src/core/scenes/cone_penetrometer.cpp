@@ -283,14 +283,8 @@ void ConePenetrometer::Sample() {
 }
 
 ConeResult ConePenetrometer::Run(const std::function<void(const ConePenetrometer&)>& progress, long every) {
-  try {
-    while (!done()) {
-      Step();
-      if (progress && dem_->step_count() % every == 0) progress(*this);
-    }
-  } catch (const SimulationError& e) {
-    error_ = e.what();
-  }
+  RunSoilRig(*this, progress ? [&](const SoilRig&) { progress(*this); } : std::function<void(const SoilRig&)>(),
+             every);
   return Result();
 }
 

@@ -56,8 +56,12 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
     double duration_;
     Ticker ticker_{1.0};
   } progress(p.duration);
-  const MobilityRunResult r = run.Run(o.quiet ? nullptr : &progress);
-  if (!o.history_file.empty()) WriteMobilityHistory(r, o.history_file);
+  MobilityRunResult r = run.Run(o.quiet ? nullptr : &progress);
+  try {
+    if (!o.history_file.empty()) WriteMobilityHistory(r, o.history_file);
+  } catch (const ConfigError& e) {  // the run is kept: its result says what failed
+    if (r.error.empty()) r.error = e.what();
+  }
   std::printf("speed_made_good: %.3f m/s (%.2f mph), status %s, window slope %.4f m/s^2\n", r.smg.value,
               r.smg.value / 0.44704, r.smg.status.c_str(), r.smg.window_slope);
   std::printf("run: %ld steps, %.2f s simulated in %.2f s wall (real-time factor %.2f)\n", r.steps, r.sim_time,

@@ -96,8 +96,11 @@ void SoilPreparation::Step() {
   auto steps_of = [dt](double t) { return std::lround(t / dt); };
   switch (phase_) {
     case Phase::kPour:
-      s_->Step();
-      if (++phase_steps_ >= steps_of(p_.settle_time)) {
+      if (phase_steps_ < steps_of(p_.settle_time)) {
+        s_->Step();
+        ++phase_steps_;
+      }
+      if (phase_steps_ >= steps_of(p_.settle_time)) {
         height_poured_ = LayerHeight(*s_);
         s_->mutable_wall(lid_).position.z() = TopParticle(*s_) + 0.6 * d;  // just clear of the highest particle
         hold_ = std::make_unique<LidHold>(s_, lid_, area_, p_.lid_pressure, p_.lid_speed,
@@ -132,8 +135,11 @@ void SoilPreparation::Step() {
       break;
     }
     case Phase::kRelease:
-      s_->Step();
-      if (++phase_steps_ >= steps_of(p_.release_time)) {
+      if (phase_steps_ < steps_of(p_.release_time)) {
+        s_->Step();
+        ++phase_steps_;
+      }
+      if (phase_steps_ >= steps_of(p_.release_time)) {
         height_consolidated_ = LayerHeight(*s_);
         NextPhase(Phase::kDone);
       }

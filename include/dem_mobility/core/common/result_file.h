@@ -9,6 +9,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "dem_mobility/core/common/error.h"
+
 namespace dem_mobility::core {
 
 class ResultFile {
@@ -22,8 +24,11 @@ class ResultFile {
   const std::string& status() const { return status_; }
   const std::string& error() const { return error_; }
 
+  /// A figure; the schema's own keys (scene, kind, status, error) are set by the constructor and
+  /// SetStatus only.
   template <class T>
   ResultFile& Set(const std::string& key, const T& value) {
+    DM_DEMAND(!Reserved(key));
     body_[key] = value;
     return *this;
   }
@@ -42,6 +47,7 @@ class ResultFile {
   static void CheckWritable(const std::string& path, const std::string& what = "");
 
  private:
+  static bool Reserved(const std::string& key);
   std::string scene_, kind_, status_ = "ok", error_;
   YAML::Node body_;
 };

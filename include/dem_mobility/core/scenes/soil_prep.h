@@ -85,7 +85,8 @@ class SoilPreparation {
   /// `who`: names the scene in error messages.
   SoilPreparation(DemSystem* s, int lid, double area, double park_z, const SoilPreparationParams& p,
                   const std::string& who);
-  /// One DEM step of the current phase. SimulationError when the lid times out (the DEM's own
+  /// One DEM step of the current phase (none for a phase of zero duration). SimulationError when
+  /// the lid takes longer than `timeout` to reach its pressure, or to come free (the DEM's own
   /// watchdogs throw too).
   void Step();
   bool done() const { return phase_ == Phase::kDone; }

@@ -1,0 +1,178 @@
+// The co-simulation's plumbing: the terrain lifecycle through a port, the coupling interval the
+// terrain advances by, the registries' errors, the one result file, and the soil preparation's
+// phases.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/result_file.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/cosim/cosim_loop.h"
+#include "dem_mobility/core/dem/dem_shapes.h"
+#include "dem_mobility/core/scenes/scene_registry.h"
+#include "dem_mobility/core/scenes/soil_prep.h"
+#include "dem_mobility/core/scenes/soil_rig.h"
+#include "dem_mobility/core/terrain/terrain_model.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
+#include "dem_test_soils.h"
+
+namespace dem_mobility::core {
+namespace {
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+// A terrain that records what the port asks of it, in order.
+class RecordingTerrain final : public TerrainModel {
+ public:
+  const TerrainDescription& description() const override { return d_; }
+  void Synchronize(long step, double t, const std::vector<WheelState>& states) override {
+    calls.push_back("synchronize " + std::to_string(step));
+    t_ = t;
+    n_ = static_cast<int>(states.size());
+  }
+  void GetWrenches(std::vector<WheelWrench>* w) const override {
+    calls.push_back("wrenches");
+    w->assign(n_, WheelWrench());
+    (*w)[0].force.z() = t_;  // the state it was synchronized with
+  }
+  void Advance(double dt) override { calls.push_back("advance " + std::to_string(dt)); }
+  const TriMesh& Surface() const override { return mesh_; }
+  mutable std::vector<std::string> calls;
+
+ private:
+  TerrainDescription d_;
+  TriMesh mesh_;
+  double t_ = 0.0;
+  int n_ = 0;
+};
+
+TEST(TerrainPort, SynchronizesAnswersThenAdvances) {
+  RecordingTerrain terrain;
+  LocalTerrainPort port(terrain);
+  std::vector<WheelWrench> w;
+  port.Exchange(7, 0.25, 1e-3, std::vector<WheelState>(kWheels), &w);
+  EXPECT_EQ(terrain.calls, (std::vector<std::string>{"synchronize 7", "wrenches", "advance " + std::to_string(1e-3)}));
+  ASSERT_EQ(w.size(), static_cast<size_t>(kWheels));
+  EXPECT_EQ(w[0].force.z(), 0.25);
+}
+
+// The vehicle exchanges every coupling interval and the terrain advances by the whole interval.
+TEST(VehicleCoSim, TerrainAdvancesByTheCouplingInterval) {
+  MobilityRunParams p = MobilityRunParams::Read(YamlReader::Load(DM_CONFIG_DIR "/scenes/road_slope.yaml"));
+  p.coupling_interval = 4;
+  const VehicleSpec spec = VehicleSpec::Load(p.vehicle_file);
+  const std::unique_ptr<TerrainModel> road = LoadTerrainModel(p.terrain_file, TerrainVehicle{spec.tire, kWheels});
+  struct Recorder final : public TerrainPort {
+    explicit Recorder(TerrainModel& m) : local(m) {}
+    void Exchange(long step, double t, double dt, const std::vector<WheelState>& s,
+                  std::vector<WheelWrench>* w) override {
+      steps.push_back(step);
+      dts.push_back(dt);
+      local.Exchange(step, t, dt, s, w);
+    }
+    const TerrainDescription& description() const override { return local.description(); }
+    LocalTerrainPort local;
+    std::vector<long> steps;
+    std::vector<double> dts;
+  } port(*road);
+  VehicleCoSim sim(p, spec);
+  sim.Start(port);
+  for (int k = 0; k < 12; ++k) sim.Step(port);
+  EXPECT_EQ(port.steps, (std::vector<long>{0, 4, 8, 12}));  // the opening exchange, then every 4th step
+  EXPECT_EQ(port.dts[0], 0.0);
+  for (size_t k = 1; k < port.dts.size(); ++k) EXPECT_EQ(port.dts[k], 4.0 * sim.dt());
+  // the result names the terrain that ran
+  EXPECT_EQ(port.description().model, "rigid_road");
+  EXPECT_EQ(port.description().cone_index, 300.0);
+}
+
+TEST(Registries, UnknownKindsAreRefusedNamingFileKeyAndTheKnownOnes) {
+  const std::string terrain = WriteTemp("bad_terrain.yaml", "model: swamp\n");
+  try {
+    LoadTerrainModel(terrain, TerrainVehicle{});
+    FAIL() << "an unknown terrain model was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(terrain + ": model"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("rigid_road"), std::string::npos) << e.what();
+  }
+  const YamlReader scene = YamlReader::FromString("scene: moon_walk\n", "s.yaml");
+  try {
+    FindSceneKind(scene);
+    FAIL() << "an unknown scene kind was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("s.yaml: scene"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cone_penetrometer"), std::string::npos) << e.what();
+  }
+  // a mobility scene is a scene but no soil rig
+  const YamlReader road = YamlReader::Load(DM_CONFIG_DIR "/scenes/road_slope.yaml");
+  EXPECT_EQ(FindSceneKind(road).scene, "road_slope");
+  EXPECT_FALSE(IsSoilRigScene("road_slope"));
+  EXPECT_TRUE(IsSoilRigScene("cone_penetrometer"));
+  EXPECT_THROW(MakeSoilRig(road), ConfigError);
+}
+
+TEST(ResultFile, OneSchemaAndExactDoubles) {
+  ResultFile f("scenes/x.yaml", "dem_pour");
+  const double third = 1.0 / 3.0, tiny = std::numeric_limits<double>::denorm_min();
+  f.Set("a", third).Set("b", tiny).SetFlow("c", {0.1, 0.2});
+  f.SetStatus("error", "it broke");
+  const YAML::Node n = YAML::Load(f.Text());
+  std::vector<std::string> keys;
+  for (const auto& kv : n) keys.push_back(kv.first.as<std::string>());
+  EXPECT_EQ(keys, (std::vector<std::string>{"scene", "kind", "status", "error", "a", "b", "c"}));
+  EXPECT_EQ(n["status"].as<std::string>(), "error");
+  EXPECT_EQ(n["a"].as<double>(), third);
+  EXPECT_EQ(n["b"].as<double>(), tiny);
+  EXPECT_THROW(f.Set("status", 1), std::logic_error);  // the schema's keys are not figures
+  EXPECT_THROW(f.Write("/nonexistent-dir/r.yaml"), ConfigError);
+}
+
+// A preparation phase of zero duration takes no DEM step; the others run in order.
+TEST(SoilPreparation, PhasesInOrderAndZeroDurationsTakeNoStep) {
+  DemSystem s(Nominal(), DemSettings());
+  for (DemWall& w : MakeOpenBoxWalls(0.3, 0.3, 0.3)) s.AddWall(std::move(w));
+  DemWall lid = MakeQuadWall("lid", {0, 0, 0}, {0, 0.3, 0}, {0.3, 0, 0});
+  lid.position.z() = 0.3;
+  const int l = s.AddWall(lid);
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) s.AddParticle(Eigen::Vector3d(0.05 + 0.05 * i, 0.05 + 0.05 * j, 0.0151));
+  s.Finalize(1.5e-5);
+  SoilPreparationParams p;
+  p.settle_time = 0.0;
+  p.hold_time = 0.01;
+  p.release_time = 0.0;
+  p.lid_speed = 0.5;
+  SoilPreparation prep(&s, l, 0.09, 0.3, p, "test");
+  prep.Step();
+  EXPECT_EQ(prep.phase(), SoilPreparation::Phase::kConsolidate);
+  EXPECT_EQ(s.step_count(), 0);
+  std::vector<SoilPreparation::Phase> seen{prep.phase()};
+  long release_start = -1;
+  while (!prep.done()) {
+    prep.Step();
+    if (prep.phase() != seen.back()) seen.push_back(prep.phase());
+    if (prep.phase() == SoilPreparation::Phase::kRelease) release_start = s.step_count();
+  }
+  EXPECT_EQ(seen, (std::vector<SoilPreparation::Phase>{
+                      SoilPreparation::Phase::kConsolidate, SoilPreparation::Phase::kRetreat,
+                      SoilPreparation::Phase::kRelease, SoilPreparation::Phase::kDone}));
+  EXPECT_EQ(s.step_count(), release_start);  // the release of zero duration took no step
+  // the lid held the pressure it was asked for (the mean over the hold) and went back to its park
+  EXPECT_NEAR(prep.lid_pressure_reached(), p.lid_pressure, 0.1 * p.lid_pressure);
+  EXPECT_EQ(s.wall(l).position.z(), 0.3);
+  EXPECT_GT(prep.height_poured(), 0.0);
+}
+
+}  // namespace
+}  // namespace dem_mobility::core
