@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/registry.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/mobility/mobility_scene.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
@@ -138,13 +139,7 @@ const std::vector<SceneKind>& SceneKinds() {
 }
 
 const SceneKind& FindSceneKind(const YamlReader& y) {
-  const std::string kind = y.String("scene");
-  std::string known;
-  for (const SceneKind& k : SceneKinds()) {
-    if (k.scene == kind) return k;
-    known += (known.empty() ? "" : ", ") + k.scene;
-  }
-  y.Fail("scene", "unknown scene '" + kind + "' (known: " + known + ")");
+  return FindKind(y, "scene", SceneKinds(), [](const SceneKind& k) { return k.scene; }, "scene");
 }
 
 }  // namespace dem_mobility::core

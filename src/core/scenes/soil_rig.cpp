@@ -1,7 +1,7 @@
 #include "dem_mobility/core/scenes/soil_rig.h"
 
 #include "dem_mobility/core/common/error.h"
-#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/common/registry.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
 
 namespace dem_mobility::core {
@@ -32,13 +32,7 @@ bool IsSoilRigScene(const std::string& kind) {
 }
 
 std::unique_ptr<SoilRig> MakeSoilRig(const YamlReader& y) {
-  const std::string kind = y.String("scene");
-  std::string known;
-  for (const SoilRigKind& k : SoilRigKinds()) {
-    if (k.scene == kind) return k.make(y);
-    known += (known.empty() ? "" : ", ") + k.scene;
-  }
-  y.Fail("scene", "'" + kind + "' is not a soil rig (rigs: " + known + ")");
+  return FindKind(y, "scene", SoilRigKinds(), [](const SoilRigKind& k) { return k.scene; }, "soil rig").make(y);
 }
 
 }  // namespace dem_mobility::core

@@ -1,7 +1,7 @@
 // The registry of terrain kinds: one row per `model:` (the next kinds are added here).
 #include <memory>
 
-#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/registry.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/terrain/road_terrain.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
@@ -17,25 +17,19 @@ const std::vector<TerrainKind>& TerrainKinds() {
 }
 
 namespace {
-const TerrainKind& FindKind(const YamlReader& y) {
-  const std::string model = y.String("model");
-  std::string known;
-  for (const TerrainKind& k : TerrainKinds()) {
-    if (k.model == model) return k;
-    known += (known.empty() ? "" : ", ") + k.model;
-  }
-  y.Fail("model", "unknown terrain model '" + model + "' (known: " + known + ")");
+const TerrainKind& FindTerrainKind(const YamlReader& y) {
+  return FindKind(y, "model", TerrainKinds(), [](const TerrainKind& k) { return k.model; }, "terrain model");
 }
 }  // namespace
 
 std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle) {
   const YamlReader y = YamlReader::Load(terrain_file);
-  return FindKind(y).make(y, vehicle);
+  return FindTerrainKind(y).make(y, vehicle);
 }
 
 TerrainDescription DescribeTerrain(const std::string& terrain_file) {
   const YamlReader y = YamlReader::Load(terrain_file);
-  return FindKind(y).describe(y);
+  return FindTerrainKind(y).describe(y);
 }
 
 }  // namespace dem_mobility::core
