@@ -16,7 +16,7 @@ DemSystem::DemSystem(const SoilParams& soil, const DemSettings& settings)
       settings_(settings),
       law_(soil),
       lists_(soil.diameter * (1.0 + settings.skin), settings.list_slack),
-      walls_(soil.diameter * (1.0 + settings.skin), soil.diameter) {
+      walls_(soil.diameter * (1.0 + settings.skin), soil.diameter, settings.wall_bins) {
   DM_THROW_UNLESS(settings.skin > 0.0 && settings.skin <= 1.0, "DEM skin ", settings.skin,
                   " (fraction of the diameter) must lie in (0, 1]");
   DM_THROW_UNLESS(settings.threads >= 1, "DEM threads ", settings.threads, " must be >= 1");

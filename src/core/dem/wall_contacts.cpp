@@ -23,14 +23,80 @@ int WallContacts::Add(DemWall wall, const SoilParams& soil, int slots) {
   DM_THROW_UNLESS(!wall.mesh.faces.empty(), "wall '", wall.name, "' has no triangles");
   DM_THROW_UNLESS(wall.friction >= 0.0 && wall.adhesion_factor >= 0.0, "wall '", wall.name,
                   "': friction and adhesion_factor must be >= 0");
+  DM_THROW_UNLESS(std::isfinite(wall.margin), "wall '", wall.name, "': margin must be finite");
   SoilParams wp = soil;
   wp.friction = wall.friction;
   law_.emplace_back(wp);
+  const double margin = wall.margin > 0.0 ? wall.margin : (wall.fast ? cutoff_ - diameter_ : cutoff_ - 0.5 * diameter_);
+  margin_.push_back(margin);
+  reach_.push_back(0.5 * diameter_ + margin);
+  tri_begin_.push_back(static_cast<int>(tris_.size()));
+  const int w = static_cast<int>(walls_.size());
+  for (int f = 0; f < static_cast<int>(wall.mesh.faces.size()); ++f) tris_.push_back({w, f});
   walls_.push_back(std::move(wall));
+  bins_.emplace_back();
+  if (use_bins_ && static_cast<int>(walls_.back().mesh.faces.size()) >= kBinMinFaces) MakeBins(w);
   // one contact history per slot and wall (nothing has touched yet: walls come before the build)
   hist_.assign(static_cast<size_t>(slots) * walls_.size(), TangentialHistory());
   touching_.assign(static_cast<size_t>(slots) * walls_.size(), 0);
   return size() - 1;
+}
+
+int WallContacts::Bins::Cell(const Vector3d& b) const {
+  const Vector3d u = (b - lo) / cell;
+  if (!(u.x() >= 0.0 && u.y() >= 0.0 && u.z() >= 0.0)) return -1;
+  const int ix = static_cast<int>(u.x()), iy = static_cast<int>(u.y()), iz = static_cast<int>(u.z());
+  if (ix >= nx || iy >= ny || iz >= nz) return -1;
+  return (iz * ny + iy) * nx + ix;
+}
+
+void WallContacts::MakeBins(int w) {
+  const TriMesh& m = walls_[w].mesh;
+  const int F = static_cast<int>(m.faces.size());
+  const double reach = reach_[w];
+  // a particle within `reach` of a face lies within (largest centroid-vertex distance + reach) of
+  // its centroid, in any frame; a little more for the round-off of the world vertices
+  std::vector<Vector3d> g(F);
+  std::vector<double> rad(F);
+  Vector3d lo = Vector3d::Constant(1e300), hi = Vector3d::Constant(-1e300);
+  for (int f = 0; f < F; ++f) {
+    const auto& fc = m.faces[f];
+    g[f] = (m.vertices[fc[0]] + m.vertices[fc[1]] + m.vertices[fc[2]]) / 3.0;
+    double rho = 0.0;
+    for (int k = 0; k < 3; ++k) rho = std::max(rho, (m.vertices[fc[k]] - g[f]).norm());
+    rad[f] = (rho + reach) * (1.0 + 1e-9) + 1e-9;
+    lo = lo.cwiseMin((g[f].array() - rad[f]).matrix());
+    hi = hi.cwiseMax((g[f].array() + rad[f]).matrix());
+  }
+  Bins& b = bins_[w];
+  b.lo = lo;
+  b.cell = reach;
+  const Vector3d ext = hi - lo;
+  while ((ext / b.cell).array().ceil().prod() > 4.0e6) b.cell *= 1.5;  // at most 4M cells
+  b.nx = std::max(1, static_cast<int>(std::ceil(ext.x() / b.cell)));
+  b.ny = std::max(1, static_cast<int>(std::ceil(ext.y() / b.cell)));
+  b.nz = std::max(1, static_cast<int>(std::ceil(ext.z() / b.cell)));
+  const size_t cells = static_cast<size_t>(b.nx) * b.ny * b.nz;
+  // two passes (count, fill) in face order: each cell's list comes out in increasing order
+  b.start.assign(cells + 1, 0);
+  auto each_cell = [&](int f, auto&& visit) {
+    const Vector3d a = (g[f].array() - rad[f] - lo.array()) / b.cell, z = (g[f].array() + rad[f] - lo.array()) / b.cell;
+    const int x0 = std::max(0, static_cast<int>(std::floor(a.x()))), x1 = std::min(b.nx - 1, static_cast<int>(z.x()));
+    const int y0 = std::max(0, static_cast<int>(std::floor(a.y()))), y1 = std::min(b.ny - 1, static_cast<int>(z.y()));
+    const int z0 = std::max(0, static_cast<int>(std::floor(a.z()))), z1 = std::min(b.nz - 1, static_cast<int>(z.z()));
+    for (int iz = z0; iz <= z1; ++iz)
+      for (int iy = y0; iy <= y1; ++iy)
+        for (int ix = x0; ix <= x1; ++ix) {
+          const Vector3d clo = lo + b.cell * Vector3d(ix, iy, iz);
+          const Vector3d d = (clo - g[f]).cwiseMax(g[f] - (clo.array() + b.cell).matrix()).cwiseMax(Vector3d::Zero());
+          if (d.squaredNorm() <= rad[f] * rad[f]) visit((iz * b.ny + iy) * b.nx + ix);
+        }
+  };
+  for (int f = 0; f < F; ++f) each_cell(f, [&](int c) { ++b.start[c + 1]; });
+  for (size_t c = 0; c < cells; ++c) b.start[c + 1] += b.start[c];
+  b.faces.resize(b.start[cells]);
+  std::vector<int> fill(b.start.begin(), b.start.end() - 1);
+  for (int f = 0; f < F; ++f) each_cell(f, [&](int c) { b.faces[fill[c]++] = f; });
 }
 
 void WallContacts::AppendSlot(bool built) {
@@ -62,21 +128,54 @@ void WallContacts::UpdateVertices() {
   }
 }
 
-double WallContacts::MaxWallDisplacement(bool fast) const {
+double WallContacts::WallDisplacement(int w) const {
+  if (w >= static_cast<int>(vertices_.size()) || w >= static_cast<int>(built_vertices_.size())) return 0.0;
   double m2 = 0.0;
-  for (size_t w = 0; w < vertices_.size() && w < built_vertices_.size(); ++w)
-    for (size_t k = 0; k < vertices_[w].size() && walls_[w].fast == fast; ++k)
-      m2 = std::max(m2, (vertices_[w][k] - built_vertices_[w][k]).squaredNorm());
+  for (size_t k = 0; k < vertices_[w].size(); ++k)
+    m2 = std::max(m2, (vertices_[w][k] - built_vertices_[w][k]).squaredNorm());
   return std::sqrt(m2);
 }
 
+double WallContacts::MaxWallDisplacement(bool fast) const {
+  double m = 0.0;
+  for (int w = 0; w < size(); ++w)
+    if (walls_[w].fast == fast) m = std::max(m, WallDisplacement(w));
+  return m;
+}
+
 bool WallContacts::NeedsBuild(double particle_displacement) const {
-  if (walls_.empty()) return false;
   // a particle's distance from where it was at the wall build is at most its distance from x_built
   // now plus the largest such distance at the build
-  const double margin = cutoff_ - 0.5 * diameter_;
-  const double walls = std::max(MaxWallDisplacement(true), MaxWallDisplacement(false));
-  return walls + particle_displacement + built_particle_displacement_ > margin;
+  const double particles = particle_displacement + built_particle_displacement_;
+  for (int w = 0; w < size(); ++w)
+    if (WallDisplacement(w) + particles > margin_[w]) return true;
+  return false;
+}
+
+bool WallContacts::Near(const Vector3d& x, int t) const {
+  if (!((x.array() >= tri_lo_[t].array()).all() && (x.array() <= tri_hi_[t].array()).all())) return false;
+  const WallTri& tr = tris_[t];
+  const auto& face = walls_[tr.wall].mesh.faces[tr.face];
+  const std::vector<Vector3d>& wv = vertices_[tr.wall];
+  const double r = reach_[tr.wall];
+  return (x - ClosestPointOnTriangle(x, wv[face[0]], wv[face[1]], wv[face[2]])).squaredNorm() <= r * r;
+}
+
+void WallContacts::SlotCandidates(const Vector3d& x, std::vector<int>* out) const {
+  for (int w = 0; w < size(); ++w) {
+    const Bins& b = bins_[w];
+    if (b.start.empty()) {
+      const int end = w + 1 < size() ? tri_begin_[w + 1] : static_cast<int>(tris_.size());
+      for (int t = tri_begin_[w]; t < end; ++t)
+        if (Near(x, t)) out->push_back(t);
+      continue;
+    }
+    const DemWall& wl = walls_[w];
+    const int c = b.Cell(wl.rotation.transpose() * (x - wl.position));
+    if (c < 0) continue;
+    for (int k = b.start[c]; k < b.start[c + 1]; ++k)
+      if (Near(x, tri_begin_[w] + b.faces[k])) out->push_back(tri_begin_[w] + b.faces[k]);
+  }
 }
 
 void WallContacts::Build(const ParticleStore& ps, int threads, double particle_displacement) {
@@ -84,29 +183,42 @@ void WallContacts::Build(const ParticleStore& ps, int threads, double particle_d
   UpdateVertices();
   built_vertices_ = vertices_;
   built_particle_displacement_ = particle_displacement;
-  tris_.clear();
-  for (int w = 0; w < size(); ++w)
-    for (int f = 0; f < static_cast<int>(walls_[w].mesh.faces.size()); ++f) tris_.push_back({w, f});
-  // each live slot's candidates: the triangles whose box, grown by the cutoff, holds it
-  std::vector<std::vector<int>> cand(n);
-  if (!tris_.empty()) {
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int i = 0; i < n; ++i) {
-      if (!ps.live(i)) continue;
-      for (int t = 0; t < static_cast<int>(tris_.size()); ++t) {
-        const WallTri& tr = tris_[t];
-        const auto& face = walls_[tr.wall].mesh.faces[tr.face];
-        const std::vector<Vector3d>& wv = vertices_[tr.wall];
-        const Vector3d tlo = wv[face[0]].cwiseMin(wv[face[1]]).cwiseMin(wv[face[2]]).array() - cutoff_;
-        const Vector3d thi = wv[face[0]].cwiseMax(wv[face[1]]).cwiseMax(wv[face[2]]).array() + cutoff_;
-        if ((ps.x[i].array() >= tlo.array()).all() && (ps.x[i].array() <= thi.array()).all()) cand[i].push_back(t);
+  // each triangle's world box, grown by its wall's reach: the cheap test before the distance
+  const int T = static_cast<int>(tris_.size());
+  tri_lo_.resize(T);
+  tri_hi_.resize(T);
+  for (int t = 0; t < T; ++t) {
+    const WallTri& tr = tris_[t];
+    const auto& face = walls_[tr.wall].mesh.faces[tr.face];
+    const std::vector<Vector3d>& wv = vertices_[tr.wall];
+    tri_lo_[t] = wv[face[0]].cwiseMin(wv[face[1]]).cwiseMin(wv[face[2]]).array() - reach_[tr.wall];
+    tri_hi_[t] = wv[face[0]].cwiseMax(wv[face[1]]).cwiseMax(wv[face[2]]).array() + reach_[tr.wall];
+  }
+  // each live slot's candidates, chunk by chunk of slots (in slot order within a chunk), then the
+  // chunks joined in order: the same lists for any thread count
+  constexpr int kChunk = 4096;
+  const int chunks = (n + kChunk - 1) / kChunk;
+  if (static_cast<int>(chunk_tris_.size()) < chunks) chunk_tris_.resize(chunks);
+  count_.assign(n, 0);
+  if (T > 0) {
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int c = 0; c < chunks; ++c) {
+      std::vector<int>& out = chunk_tris_[c];
+      out.clear();
+      for (int i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
+        if (!ps.live(i)) continue;
+        const size_t before = out.size();
+        SlotCandidates(ps.x[i], &out);
+        count_[i] = static_cast<int>(out.size() - before);
       }
     }
   }
   tri_start_.assign(n + 1, 0);
-  for (int i = 0; i < n; ++i) tri_start_[i + 1] = tri_start_[i] + static_cast<int>(cand[i].size());
+  for (int i = 0; i < n; ++i) tri_start_[i + 1] = tri_start_[i] + count_[i];
   tri_of_slot_.resize(tri_start_[n]);
-  for (int i = 0; i < n; ++i) std::copy(cand[i].begin(), cand[i].end(), tri_of_slot_.begin() + tri_start_[i]);
+  if (T > 0)
+    for (int c = 0; c < chunks; ++c)
+      std::copy(chunk_tris_[c].begin(), chunk_tris_[c].end(), tri_of_slot_.begin() + tri_start_[c * kChunk]);
   ++builds_;
 }
 
@@ -115,8 +227,25 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
   // build tries them all); the candidates come in wall order: one pass, a group per wall
   const int W = size();
   const bool fresh = ps->state[i] == SlotState::kAdded;
+  // a particle added since the build: every triangle near it now (its cell's, on a binned wall)
+  thread_local std::vector<int> fresh_tris;
+  if (fresh) {
+    fresh_tris.clear();
+    for (int w = 0; w < W; ++w) {
+      const Bins& b = bins_[w];
+      const int end = w + 1 < W ? tri_begin_[w + 1] : static_cast<int>(tris_.size());
+      if (b.start.empty()) {
+        for (int t = tri_begin_[w]; t < end; ++t) fresh_tris.push_back(t);
+        continue;
+      }
+      const DemWall& wl = walls_[w];
+      const int c = b.Cell(wl.rotation.transpose() * (ps->x[i] - wl.position));
+      if (c >= 0)
+        for (int k = b.start[c]; k < b.start[c + 1]; ++k) fresh_tris.push_back(tri_begin_[w] + b.faces[k]);
+    }
+  }
   const int t_begin = fresh ? 0 : tri_start_[i];
-  const int t_end = fresh ? static_cast<int>(tris_.size()) : tri_start_[i + 1];
+  const int t_end = fresh ? static_cast<int>(fresh_tris.size()) : tri_start_[i + 1];
   if (t_begin == t_end) {  // no wall near: clear what an earlier contact left
     for (int w = 0; w < W; ++w) ClearHistory(static_cast<size_t>(i) * W + w);
     return;
@@ -126,7 +255,7 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
   const double pi = ps->plastic[i], ai = ps->adhesion_max[i];
   Vector3d f = ps->f[i];
   double max_rep = ps->max_repulsion[i], max_ten = ps->max_tension[i], max_overlap = ps->overlap[i];
-  auto tri_at = [&](int t) -> const WallTri& { return tris_[fresh ? t : tri_of_slot_[t]]; };
+  auto tri_at = [&](int t) -> const WallTri& { return tris_[fresh ? fresh_tris[t] : tri_of_slot_[t]]; };
   int t = t_begin;
   for (int w = 0; w < W; ++w) {
     const size_t hw = static_cast<size_t>(i) * W + w;
@@ -171,6 +300,7 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
     sum[w].force -= fc;
     sum[w].moment += (q_best - wl.wrench_point).cross(-fc);
     sum[w].power += fc.dot(vw);  // the wall's work on the particle, per unit time
+    sum[w].normal += fn.Total();
     ++sum[w].contacts;
   }
   ps->f[i] = f;
@@ -187,11 +317,13 @@ double WallContacts::SumWrenches(int chunks) {
     wl.force.setZero();
     wl.moment.setZero();
     wl.contacts = 0;
+    wl.normal_force = 0.0;
     for (int c = 0; c < chunks; ++c) {
       const WallSum& cs = chunk_[static_cast<size_t>(c) * W + w];
       wl.force += cs.force;
       wl.moment += cs.moment;
       wl.contacts += cs.contacts;
+      wl.normal_force += cs.normal;
       power += cs.power;
     }
   }
@@ -216,7 +348,11 @@ double WallContacts::Compute(ParticleStore* ps, double dt, int threads) {
 
 size_t WallContacts::MemoryBytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  return bytes(hist_) + bytes(touching_) + bytes(tri_start_) + bytes(tri_of_slot_) + bytes(chunk_);
+  size_t b = bytes(hist_) + bytes(touching_) + bytes(tri_start_) + bytes(tri_of_slot_) + bytes(chunk_) +
+             bytes(tri_lo_) + bytes(tri_hi_) + bytes(count_) + bytes(tris_);
+  for (const Bins& bn : bins_) b += bytes(bn.start) + bytes(bn.faces);
+  for (const std::vector<int>& c : chunk_tris_) b += bytes(c);
+  return b;
 }
 
 }  // namespace dem_mobility::core

@@ -11,6 +11,7 @@
 #include "dem_mobility/core/mobility/mobility_scene.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
 #include "dem_mobility/core/scenes/dem_pour.h"
+#include "dem_mobility/core/scenes/single_wheel.h"
 #include "dem_mobility/core/scenes/uniaxial_compression.h"
 
 namespace dem_mobility::core {
@@ -111,6 +112,40 @@ ResultFile RunConeScene(const YamlReader& reader, const SceneRunOptions& o) {
   return ConeResultFile(r, p);
 }
 
+ResultFile RunSingleWheelScene(const YamlReader& reader, const SceneRunOptions& o) {
+  const SingleWheelParams p = SingleWheelParams::Read(reader);
+  const SoilBinLevel& l = p.bin.level;
+  std::printf("scene %s: level '%s', f %.4g, mu %.3g, %d particles of %.3g m in a %.3g x %.3g m bin, dt %.3g s, "
+              "%d thread(s); wheel %s, load %.0f kg, carriage %.3g m/s\n",
+              p.file.c_str(), l.name.c_str(), p.bin.cohesion_factor, p.bin.friction, p.bin.ParticleCount(),
+              l.particle_diameter, l.length, l.width, l.time_step, p.bin.threads,
+              p.drive == SingleWheelParams::Drive::kSlip ? ("at slip " + std::to_string(p.slip)).c_str()
+                                                          : SingleWheelParams::DriveName(p.drive),
+              p.load_mass, p.speed);
+  std::fflush(stdout);
+  SingleWheelRig rig(p);
+  Ticker ticker(2.0);
+  RunSoilRig(
+      rig,
+      [&](const SoilRig& r) {
+        if (o.quiet || !ticker.Due()) return;
+        std::printf("  %7.1f s wall  %s\n", ticker.Elapsed(), r.StatusLine().c_str());
+        std::fflush(stdout);
+      },
+      500);
+  const SingleWheelRig::Window w = rig.Measured();
+  const double W = p.Weight(), R = p.tire.radius;
+  std::printf("prepared: surface %.3f m, lid %.1f kPa held\n", rig.bin().surface_height(),
+              rig.bin().preparation().lid_pressure_reached() * 1e-3);
+  std::printf("window %.2f-%.2f m (%d samples): DP/W %.4f (std %.4f), T/(Wr) %.4f (std %.4f), sinkage %.4f m "
+              "(std %.4f), slip %.4f\n",
+              p.window_from, p.window_to, w.samples, w.dp / W, w.dp_std / W, w.torque / (W * R),
+              w.torque_std / (W * R), w.sinkage, w.sinkage_std, w.slip);
+  std::printf("run: %ld steps, %.3f s simulated in %.1f s wall (%.1f s preparation)\n", rig.dem().step_count(),
+              rig.dem().time(), rig.wall_time(), rig.preparation_wall_time());
+  return rig.Report();
+}
+
 ResultFile RunCompressionScene(const YamlReader& reader, const SceneRunOptions&) {
   const CompressionParams p = CompressionParams::Read(reader);
   std::printf("scene %s: %.3g m particles in a %.3g m cylinder, f %.3g, dt %.3g s\n", p.file.c_str(),
@@ -134,6 +169,8 @@ const std::vector<SceneKind>& SceneKinds() {
       {"dem_pour", "soil preparation: pour, settle, consolidate with a lid, release", &RunPourScene},
       {"cone_penetrometer", "the cone penetrometer: cone index of a prepared soil", &RunConeScene},
       {"uniaxial_compression", "piston-cylinder compression: bulk density against pressure", &RunCompressionScene},
+      {"single_wheel", "the single-wheel rig: drawbar pull, torque and sinkage of a tire on DEM soil at a slip",
+       &RunSingleWheelScene},
   };
   return kinds;
 }

@@ -3,6 +3,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/registry.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
+#include "dem_mobility/core/scenes/single_wheel.h"
 
 namespace dem_mobility::core {
 
@@ -21,6 +22,8 @@ const std::vector<SoilRigKind>& SoilRigKinds() {
   static const std::vector<SoilRigKind> kinds = {
       {"cone_penetrometer",
        [](const YamlReader& y) { return std::make_unique<ConePenetrometer>(ConeParams::Read(y)); }},
+      {"single_wheel",
+       [](const YamlReader& y) { return std::make_unique<SingleWheelRig>(SingleWheelParams::Read(y)); }},
   };
   return kinds;
 }

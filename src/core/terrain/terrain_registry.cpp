@@ -3,6 +3,7 @@
 
 #include "dem_mobility/core/common/registry.h"
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/terrain/dem_soil.h"
 #include "dem_mobility/core/terrain/road_terrain.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 
@@ -12,6 +13,8 @@ const std::vector<TerrainKind>& TerrainKinds() {
   static const std::vector<TerrainKind> kinds = {
       {"rigid_road", "a rigid polygonal road (tire vertices against its triangles, asperity friction)",
        [](const YamlReader& y, const TerrainVehicle& v) { return MakeRoadTerrain(y, v); }, &DescribeRoadTerrain},
+      {"dem_soil", "a DEM soil bin (cohesive particles, prepared under a lid) the tires sink into",
+       [](const YamlReader& y, const TerrainVehicle& v) { return MakeDemSoilTerrain(y, v); }, &DescribeDemSoilTerrain},
   };
   return kinds;
 }

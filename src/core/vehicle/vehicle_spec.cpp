@@ -46,12 +46,7 @@ RodSpec ReadRod(const YamlReader& y) {
   return r;
 }
 
-TireGeometry ReadTire(const YamlReader& tire) {
-  TireGeometry t = TireGeometry::Make(tire.Positive("radius"), tire.Positive("width"),
-                                      tire.NonNegative("shoulder_radius"), tire.Int("n_circ"), tire.Int("n_lat"));
-  tire.Finish();
-  return t;
-}
+TireGeometry ReadTire(const YamlReader& tire) { return TireGeometry::Read(tire); }
 
 DrivelineSpec ReadDriveline(const YamlReader& driveline) {
   DrivelineSpec d;

@@ -39,6 +39,7 @@ struct DemSettings {
                                 ///< soil sits at d0 = 5 % and compacts plastically by up to ~8 % more)
   int max_coordination = 12;    ///< contacts per particle assumed by the time-step guard
   int list_slack = 2;           ///< spare neighbour slots per particle for particles added later
+  bool wall_bins = true;        ///< bin large walls' triangles (false: scan them all; same results)
 };
 
 class DemSystem {
@@ -100,6 +101,9 @@ class DemSystem {
   long neighbour_builds() const { return builds_; }
   /// Builds of the wall candidates (with every neighbour build, and on their own when walls move).
   long wall_builds() const { return walls_.builds(); }
+  /// Wall candidate triangles over all particles at the last wall build.
+  long wall_candidates() const { return walls_.candidates(); }
+  const WallContacts& wall_contacts() const { return walls_; }
   /// Of those, the builds forced by an added particle whose neighbour's list had no room left.
   long overflow_builds() const { return overflow_builds_; }
   int contacts() const { return lists_.contacts(); }  ///< pairs in contact at the last force evaluation

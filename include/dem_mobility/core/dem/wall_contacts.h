@@ -1,12 +1,19 @@
 // Particle-wall contacts of the DEM: the walls, their world vertices, each slot's candidate
 // triangles, one tangential history per slot and wall, and the walls' wrenches.
 //
-// Candidates: the triangles whose bounding box, grown by the cutoff, holds the particle at the
-// wall build. A particle touches a triangle only within half a diameter of it, so the candidates
-// stay complete while the largest wall-vertex displacement plus the largest particle displacement
-// since the wall build stays below cutoff - d / 2 (the margin). The walls (a wheel moves much faster
-// than the soil) are rebuilt on their own when that is exceeded; a particle added since the last
-// neighbour build tries every triangle.
+// Candidates: the triangles within d / 2 + margin of the particle at the wall build (the margin
+// is the wall's own: cutoff - d / 2 for a slow wall, the skin for a fast one). A particle touches a
+// triangle only within half a diameter of it, and a point of a rigid triangle moves no more than
+// its vertices, so the candidates stay complete while a wall's largest vertex displacement plus the
+// particles' largest displacement since the wall build stays below its margin. The candidates are
+// rebuilt on their own when that is exceeded; a particle added since the last neighbour build tries
+// every triangle.
+//
+// Binned walls (meshes of many triangles: a tire): the triangles are binned once in the wall's body
+// frame (a rigid wall never changes shape), each cell listing every triangle that can be within
+// reach of a point in it. A build looks up each particle's cell instead of scanning all triangles,
+// so its cost scales with the particles near the wall; the candidates are the same, in the same
+// order, as the scan's (DemSettings::wall_bins switches the bins off to compare).
 //
 // The wrenches are summed in fixed chunks of slots, in slot order, and the chunks in order: the
 // same sums for any thread count, without a force per particle and wall.
@@ -41,9 +48,14 @@ struct DemWall {
   /// (WallContacts::NeedsBuild). A slow one (container, lid, cone) moving half the skin rebuilds
   /// the particles' neighbour lists too, as a particle moving that far does.
   bool fast = false;
+  /// How far the wall and the particles may move between candidate builds [m]; <= 0: the default
+  /// (the skin, d * skin, for a fast wall; cutoff - d / 2 for a slow one). A smaller margin means
+  /// fewer candidates per particle and more builds.
+  double margin = 0.0;
   // results of the last force evaluation
   Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< on the wall, world
   Eigen::Vector3d moment = Eigen::Vector3d::Zero();  ///< on the wall about wrench_point, world
+  double normal_force = 0.0;  ///< sum of the contacts' normal forces (> 0 pushing)
   int contacts = 0;
 };
 
@@ -53,8 +65,12 @@ DemWall MakeQuadWall(const std::string& name, const Eigen::Vector3d& o, const Ei
 
 class WallContacts {
  public:
-  /// `cutoff`: the candidate box growth; `diameter`: the particles' contact diameter.
-  WallContacts(double cutoff, double diameter) : cutoff_(cutoff), diameter_(diameter) {}
+  /// `cutoff`: the neighbour lists' cutoff; `diameter`: the particles' contact diameter; `bins`:
+  /// bin the triangles of large walls (false: every build scans every triangle).
+  WallContacts(double cutoff, double diameter, bool bins = true)
+      : cutoff_(cutoff), diameter_(diameter), use_bins_(bins) {}
+  /// Walls with at least this many triangles are binned.
+  static constexpr int kBinMinFaces = 64;
 
   /// Adds a wall (before the first build, `slots` slots so far); returns its index.
   int Add(DemWall wall, const SoilParams& soil, int slots);
@@ -83,16 +99,31 @@ class WallContacts {
   /// The largest distance of a vertex of the fast (or the slow) walls from where it was at the
   /// wall build.
   double MaxWallDisplacement(bool fast) const;
+  /// The largest distance of a vertex of wall w from where it was at the wall build.
+  double WallDisplacement(int w) const;
+  double margin(int w) const { return margin_[w]; }
+  bool binned(int w) const { return !bins_[w].start.empty(); }
   long builds() const { return builds_; }
+  /// Candidate triangles over all slots at the last build (a measure of the per-step cost).
+  long candidates() const { return static_cast<long>(tri_of_slot_.size()); }
   size_t MemoryBytes() const;
 
  private:
   struct WallTri {
     int wall, face;
   };
+  /// A wall's triangles binned in its body frame: cell (ix, iy, iz) lists, in increasing order, the
+  /// faces whose centroid lies within (largest centroid-vertex distance + reach) of the cell.
+  struct Bins {
+    Eigen::Vector3d lo = Eigen::Vector3d::Zero();
+    double cell = 1.0;
+    int nx = 0, ny = 0, nz = 0;
+    std::vector<int> start, faces;  ///< CSR per cell
+    int Cell(const Eigen::Vector3d& body) const;
+  };
   struct WallSum {
     Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
-    double power = 0.0;
+    double power = 0.0, normal = 0.0;
     int contacts = 0;
   };
   void ClearHistory(size_t hw) {
@@ -102,10 +133,21 @@ class WallContacts {
     }
   }
   void ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum);
+  void MakeBins(int w);
+  /// Appends slot i's candidates to `out`.
+  void SlotCandidates(const Eigen::Vector3d& x, std::vector<int>* out) const;
+  bool Near(const Eigen::Vector3d& x, int t) const;
   double SumWrenches(int chunks);
 
   double cutoff_, diameter_;
+  bool use_bins_;
   long builds_ = 0;
+  std::vector<double> margin_, reach_;  ///< per wall: its margin, and d / 2 + margin
+  std::vector<Bins> bins_;
+  std::vector<int> tri_begin_;          ///< per wall: its first index in tris_
+  std::vector<Eigen::Vector3d> tri_lo_, tri_hi_;  ///< per triangle: its world box at the build, grown by the reach
+  std::vector<std::vector<int>> chunk_tris_;      ///< per chunk of slots at a build: the candidates
+  std::vector<int> count_;                        ///< per slot at a build: its number of candidates
   std::vector<DemWall> walls_;
   std::vector<SoilContactLaw> law_;  ///< the soil law with each wall's friction
   std::vector<std::vector<Eigen::Vector3d>> vertices_, built_vertices_;  ///< world, now and at the build

@@ -20,6 +20,8 @@ struct CiCalibration {
   /// Reads a calibration file; ConfigError names file and key (rows not increasing, ...).
   static CiCalibration Read(const YamlReader& y);
   static CiCalibration Load(const std::string& path);
+  static CiCalibration LoadFor(const std::string& path, double particle_diameter, double friction);
+  void Describe(class ResultFile* r) const;
   /// f for a requested CI, interpolated in the table; ConfigError outside the table's range.
   double CohesionFactor(double ci_psi) const;
   /// The CI the table predicts for f (the inverse interpolation); ConfigError outside its range.

@@ -1,0 +1,317 @@
+#include "dem_mobility/core/terrain/dem_soil.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/result_file.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/dem/dem_shapes.h"
+
+namespace dem_mobility::core {
+
+using Eigen::Vector3d;
+
+namespace {
+
+constexpr double kMinCohesionFactor = 0.05, kMaxCohesionFactor = 12.0;  // the paper's range
+
+SoilBinLevel ReadBinLevel(const YamlReader& y, const std::string& name) {
+  SoilBinLevel l;
+  l.name = name;
+  l.particle_diameter = y.DoubleIn("particle_diameter", 0.005, 0.5);
+  l.length = y.DoubleIn("length", 0.1, 1000.0);
+  l.width = y.DoubleIn("width", 0.1, 100.0);
+  l.soil_depth = y.DoubleIn("soil_depth", 0.05, 10.0);
+  l.time_step = y.DoubleIn("time_step", 1e-8, 1e-3);
+  l.settle_time = y.DoubleIn("settle_time", 0.0, 100.0);
+  l.hold_time = y.DoubleIn("hold_time", 0.0, 100.0);
+  y.Finish();
+  if (l.soil_depth < 3.0 * l.particle_diameter)
+    y.Fail("soil_depth", "must be at least three particle diameters (" + detail::Concat(3.0 * l.particle_diameter) + " m)");
+  return l;
+}
+
+}  // namespace
+
+DemSoilParams DemSoilParams::Read(const YamlReader& y) {
+  DemSoilParams p;
+  p.file = y.file();
+  p.soil = SoilParams::Read(YamlReader::Load(y.ResolvePath(y.String("soil"))));
+  // the fidelity level: every level is checked, the named one is used
+  const std::string fidelity = y.String("fidelity");
+  const YamlReader levels = y.Child("levels");
+  std::string names;
+  bool found = false;
+  for (const std::string& name : levels.Keys()) {
+    const SoilBinLevel l = ReadBinLevel(levels.Child(name), name);
+    names += (names.empty() ? "" : ", ") + name;
+    if (name == fidelity) {
+      p.level = l;
+      found = true;
+    }
+  }
+  if (!found) y.Fail("fidelity", "no level '" + fidelity + "' under levels: (" + names + ")");
+  p.friction = y.DoubleIn("friction", 0.0, 2.0);
+  // the soil: f directly, or from a requested cone index through the calibration table made at
+  // this level's particle size
+  if (y.Has("calibration")) p.calibration_file = y.ResolvePath(y.String("calibration"));
+  if (y.Has("cone_index")) {
+    if (y.Has("cohesion_factor")) y.Fail("cone_index", "and cohesion_factor are both set: give one");
+    p.requested_ci = y.Positive("cone_index");
+    if (p.calibration_file.empty()) y.Fail("calibration", "is needed to turn cone_index into f");
+    try {
+      p.calibration = std::make_shared<CiCalibration>(
+          CiCalibration::LoadFor(p.calibration_file, p.level.particle_diameter, p.friction));
+      p.cohesion_factor = p.calibration->CohesionFactor(p.requested_ci);
+    } catch (const ConfigError& e) {
+      y.Fail("cone_index", e.what());
+    }
+  } else {
+    if (!y.Has("cohesion_factor")) y.Fail("cohesion_factor", "is not set (nor is cone_index)");
+    p.cohesion_factor = y.Double("cohesion_factor");
+    if (!p.calibration_file.empty()) {
+      // the table only names the CI this f stands for; a table for another size is refused
+      try {
+        p.calibration = std::make_shared<CiCalibration>(
+            CiCalibration::LoadFor(p.calibration_file, p.level.particle_diameter, p.friction));
+      } catch (const ConfigError& e) {
+        y.Fail("calibration", e.what());
+      }
+    }
+  }
+  if (!(p.cohesion_factor >= kMinCohesionFactor && p.cohesion_factor <= kMaxCohesionFactor))
+    y.Fail(y.Has("cone_index") ? "cone_index" : "cohesion_factor",
+           "the cohesion factor f = " + detail::Concat(p.cohesion_factor) + " lies outside the paper's range [" +
+               detail::Concat(kMinCohesionFactor) + ", " + detail::Concat(kMaxCohesionFactor) + "]");
+  p.soil.diameter = p.level.particle_diameter;
+  p.soil.cohesion_factor = p.cohesion_factor;
+  p.soil.friction = p.friction;
+  p.threads = ReadThreads(y);
+  p.seed = static_cast<unsigned>(y.Int("seed", 1));
+  if (y.Has("bin")) {
+    const YamlReader b = y.Child("bin");
+    p.origin = b.Vector3("origin", Vector3d::Zero());
+    p.solid_fraction = b.DoubleIn("solid_fraction", 0.2, 0.74, 0.58);
+    p.consolidation = b.DoubleIn("consolidation", 0.3, 1.0, 0.7);
+    p.max_overlap = b.DoubleIn("max_overlap", 0.05, 0.9, 0.4);
+    b.Finish();
+  }
+  const YamlReader lid = y.Child("lid");
+  p.prep.lid_pressure = lid.Positive("pressure");
+  p.prep.lid_speed = lid.DoubleIn("speed", 1e-4, 10.0);
+  p.prep.release_time = lid.DoubleIn("release_time", 0.0, 100.0);
+  p.prep.timeout = lid.DoubleIn("timeout", 0.1, 1000.0, 30.0);
+  lid.Finish();
+  p.prep.settle_time = p.level.settle_time;
+  p.prep.hold_time = p.level.hold_time;
+  if (y.Has("tire_contact")) {
+    const YamlReader t = y.Child("tire_contact");
+    p.tire_friction = t.DoubleIn("friction", 0.0, 5.0, 0.5);
+    p.tire_adhesion = t.DoubleIn("adhesion_factor", 0.0, 10.0, 0.0);
+    p.wall_margin = t.DoubleIn("margin", 0.0, 1.0, 0.0);
+    t.Finish();
+  }
+  return p;
+}
+
+int DemSoilParams::ParticleCount() const {
+  const double d = level.particle_diameter;
+  const double poured = level.soil_depth / consolidation;
+  return static_cast<int>(std::lround(solid_fraction * level.length * level.width * poured / (M_PI / 6.0 * d * d * d)));
+}
+
+double DemSoilParams::ConeIndex() const {
+  if (std::isfinite(requested_ci)) return requested_ci;
+  if (!calibration) return std::numeric_limits<double>::quiet_NaN();
+  try {
+    return calibration->ConeIndex(cohesion_factor);
+  } catch (const ConfigError&) {
+    return std::numeric_limits<double>::quiet_NaN();  // f outside the table: no CI to name
+  }
+}
+
+void DemSoilParams::Describe(ResultFile* r) const {
+  r->Set("fidelity", level.name);
+  r->Set("particle_diameter", level.particle_diameter);
+  r->Set("cohesion_factor", cohesion_factor);
+  r->Set("friction", friction);
+  if (std::isfinite(requested_ci)) r->Set("requested_cone_index_psi", requested_ci);
+  const double ci = ConeIndex();
+  if (std::isfinite(ci))
+    r->Set("cone_index_psi", ci);
+  else
+    r->Set("cone_index_psi", std::string("unknown: f given directly and no calibration table at this particle size"));
+  if (calibration) calibration->Describe(r);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int wheels) : p_(p), tire_(tire) {
+  const SoilBinLevel& l = p.level;
+  const double d = l.particle_diameter;
+  DM_THROW_UNLESS(wheels >= 1 && wheels <= 64, "dem_soil: ", wheels, " wheels (1 to 64)");
+  if (tire.width + 2.0 * d > l.width)
+    throw ConfigError(detail::Concat(p.file, ": levels.", l.name, ".width: the bin (", l.width,
+                                     " m) is narrower than the tire (", tire.width, " m) plus two particle diameters"));
+  DemSettings st;
+  st.threads = p.threads;
+  st.max_overlap = p.max_overlap;
+  dem_ = std::make_unique<DemSystem>(p.soil, st);
+  DemSystem& s = *dem_;
+  const Vector3d o = p.origin - Vector3d(0.0, 0.5 * l.width, 0.0);
+  const std::vector<Vector3d> lattice = PourLattice(
+      p.ParticleCount(), d, 1.1, {0.0, 0.0}, {l.length, l.width},
+      [&](double x, double y) { return x >= 0.6 * d && x <= l.length - 0.6 * d && y >= 0.6 * d && y <= l.width - 0.6 * d; },
+      p.seed);
+  double top = 0.0;
+  for (const Vector3d& x : lattice) top = std::max(top, x.z());
+  wall_height_ = top + 2.0 * d;
+  for (DemWall& w : MakeOpenBoxWalls(l.length, l.width, wall_height_)) {
+    for (Vector3d& v : w.mesh.vertices) v += o;
+    container_.push_back(s.AddWall(std::move(w)));
+  }
+  DemWall lid = MakeQuadWall("lid", Vector3d(0, 0, 0), Vector3d(l.length, 0, 0), Vector3d(0, l.width, 0));
+  for (Vector3d& v : lid.mesh.vertices) v += Vector3d(o.x(), o.y(), 0.0);
+  lid.position = Vector3d(0, 0, o.z() + top + d);
+  lid_ = s.AddWall(std::move(lid));
+  // the tires: parked high above the bin until a wheel state puts them somewhere
+  for (int k = 0; k < wheels; ++k) {
+    DemWall w;
+    w.name = wheels == 1 ? std::string("tire") : std::string("tire_") + (k < kWheels ? kWheelNames[k] : std::to_string(k));
+    w.mesh = tire.soil_mesh;
+    w.friction = p.tire_friction;
+    w.adhesion_factor = p.tire_adhesion;
+    w.fast = true;
+    w.margin = p.wall_margin;
+    w.position = o + Vector3d(0.5 * l.length + 3.0 * k, 0.5 * l.width, wall_height_ + 10.0 + tire.radius);
+    w.wrench_point = w.position;
+    centres_.push_back(w.position);
+    tire_walls_.push_back(s.AddWall(std::move(w)));
+  }
+  for (const Vector3d& x : lattice) s.AddParticle(o + x);
+  s.Finalize(l.time_step);
+  prep_ = std::make_unique<SoilPreparation>(&s, lid_, l.length * l.width, o.z() + wall_height_ + 1.0, p.prep,
+                                            "dem_soil bin (" + p.file + ")");
+}
+
+void DemSoilBin::PrepareStep() {
+  prep_->Step();
+  if (prep_->done()) surface_ = prep_->height_consolidated();  // (the particles are in the scene frame)
+}
+
+void DemSoilBin::SetWheel(int k, const WheelState& s) {
+  DM_THROW_UNLESS(s.position.allFinite() && s.velocity.allFinite() && s.angular_velocity.allFinite() &&
+                      s.orientation.coeffs().allFinite(),
+                  "dem_soil: wheel ", k, " state is not finite");
+  DemWall& w = dem_->mutable_wall(tire_walls_[k]);
+  w.position = s.position;
+  w.rotation = s.orientation.normalized().toRotationMatrix();
+  w.velocity = s.velocity;
+  w.angular_velocity = s.angular_velocity;
+  w.wrench_point = s.position;
+  centres_[k] = s.position;
+}
+
+WheelWrench DemSoilBin::Wrench(int k) const {
+  const DemWall& w = dem_->wall(tire_walls_[k]);
+  WheelWrench r;
+  r.force = w.force;
+  r.moment = w.moment;
+  r.contacts = w.contacts;
+  r.normal_force = w.normal_force;
+  r.sinkage = w.contacts > 0 ? std::max(0.0, surface_ - (centres_[k].z() - tire_.radius)) : 0.0;
+  // each contact is one particle's spring and dashpot (eq. 12b): their sum bounds the tire's
+  r.stiffness = w.contacts * p_.soil.NormalStiffness();
+  r.damping = w.contacts * p_.soil.NormalDamping();
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels)
+    : bin_(std::make_unique<DemSoilBin>(p, tire, wheels)) {
+  description_.file = p.file;
+  description_.model = "dem_soil";
+  description_.cone_index = p.ConeIndex();
+  while (!bin_->prepared()) bin_->PrepareStep();
+  // the display surface: the bin's consolidated top
+  const SoilBinLevel& l = p.level;
+  const double z = bin_->surface_height();
+  const Vector3d o = p.origin - Vector3d(0.0, 0.5 * l.width, 0.0);
+  surface_mesh_.vertices = {Vector3d(o.x(), o.y(), z), Vector3d(o.x() + l.length, o.y(), z),
+                            Vector3d(o.x() + l.length, o.y() + l.width, z), Vector3d(o.x(), o.y() + l.width, z)};
+  surface_mesh_.faces = {{0, 1, 2}, {0, 2, 3}};
+  wrenches_.assign(wheels, WheelWrench());
+}
+
+void DemSoilTerrain::Synchronize(long, double, const std::vector<WheelState>& states) {
+  DM_THROW_UNLESS(static_cast<int>(states.size()) == bin_->wheels(), "dem_soil: ", states.size(),
+                  " wheel states for ", bin_->wheels(), " tires");
+  states_ = states;
+}
+
+void DemSoilTerrain::GetWrenches(std::vector<WheelWrench>* wrenches) const { *wrenches = wrenches_; }
+
+void DemSoilTerrain::Advance(double dt) {
+  if (dt == 0.0) return;
+  const double h = bin_->params().level.time_step;
+  const double ratio = dt / h;
+  const long n = std::lround(ratio);
+  if (n < 1 || std::abs(ratio - n) > 1e-6 * ratio)
+    throw SimulationError(detail::Concat("dem_soil (", bin_->params().file, "): the exchange step ", dt,
+                                         " s is not a whole multiple of the soil's time step ", h,
+                                         " s (levels.", bin_->params().level.name, ".time_step)"));
+  const int W = bin_->wheels();
+  std::vector<WheelWrench> sum(W);
+  for (long k = 1; k <= n; ++k) {
+    // each tire moves on at its synchronized velocities to where it is at the end of this step
+    for (int w = 0; w < W; ++w) {
+      WheelState s = states_[w];
+      const double t = k * h;
+      s.position += s.velocity * t;
+      const double angle = s.angular_velocity.norm() * t;
+      if (angle > 0.0)
+        s.orientation = Eigen::AngleAxisd(angle, s.angular_velocity.normalized()) * s.orientation;
+      bin_->SetWheel(w, s);
+    }
+    bin_->Step();
+    for (int w = 0; w < W; ++w) {
+      const WheelWrench r = bin_->Wrench(w);
+      sum[w].force += r.force;
+      sum[w].moment += r.moment + (bin_->dem().wall(bin_->tire_wall(w)).position - states_[w].position).cross(r.force);
+      sum[w].normal_force += r.normal_force;
+      if (k == n) {
+        sum[w].contacts = r.contacts;
+        sum[w].sinkage = r.sinkage;
+        sum[w].stiffness = r.stiffness;
+        sum[w].damping = r.damping;
+      }
+    }
+  }
+  for (int w = 0; w < W; ++w) {
+    sum[w].force /= n;
+    sum[w].moment /= n;
+    sum[w].normal_force /= n;
+  }
+  wrenches_ = sum;
+}
+
+std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle) {
+  const DemSoilParams p = DemSoilParams::Read(y);
+  y.String("model");
+  y.Finish();
+  return std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels);
+}
+
+TerrainDescription DescribeDemSoilTerrain(const YamlReader& y) {
+  const DemSoilParams p = DemSoilParams::Read(y);
+  TerrainDescription d;
+  d.file = y.file();
+  d.model = "dem_soil";
+  d.cone_index = p.ConeIndex();
+  return d;
+}
+
+}  // namespace dem_mobility::core
