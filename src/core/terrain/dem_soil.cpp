@@ -57,8 +57,8 @@ DemSoilParams DemSoilParams::Read(const YamlReader& y) {
   // the soil: f directly, or from a requested cone index through the calibration table made at
   // this level's particle size
   if (y.Has("calibration")) p.calibration_file = y.ResolvePath(y.String("calibration"));
-  if (y.Has("cone_index")) {
-    if (y.Has("cohesion_factor")) y.Fail("cone_index", "and cohesion_factor are both set: give one");
+  if (y.Has("cone_index")) {  // (it takes the place of a cohesion_factor in the file)
+    if (y.Has("cohesion_factor")) y.Double("cohesion_factor");
     p.requested_ci = y.Positive("cone_index");
     if (p.calibration_file.empty()) y.Fail("calibration", "is needed to turn cone_index into f");
     try {
