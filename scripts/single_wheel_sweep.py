@@ -415,7 +415,7 @@ def plots(doc, outcomes, out):
             sunk = [i for i, st in enumerate(p['status']) if st == 'sunk']
             label = 'DEM, %s' % soil['soil']
             if soil['cone_index_psi'] is not None and not soil['soil'].startswith('ci'):
-                label += ' (CI %g psi)' % soil['cone_index_psi']
+                label += ' (CI %.1f psi)' % soil['cone_index_psi']
             if good:
                 ax.errorbar([p['slip'][i] for i in good], [p[key][i] for i in good],
                             yerr=[p[key + '_std'][i] or 0.0 for i in good], fmt='o-', color=c, capsize=3, lw=1.5,
@@ -645,7 +645,7 @@ def main(argv=None):
 
 
 def print_soil(s):
-    head = '%s: CI %s psi' % (s['soil'], '%g' % s['cone_index_psi'] if s['cone_index_psi'] is not None else '?')
+    head = '%s: CI %s psi' % (s['soil'], '%.1f' % s['cone_index_psi'] if s['cone_index_psi'] is not None else '?')
     if s.get('reference') is None:
         print('%s; no reference: %s' % (head, s.get('no_reference')))
     else:
@@ -667,8 +667,10 @@ def print_soil(s):
             f(p['torque_over_wr'][i]), f(p['torque_over_wr_std'][i], '%5.3f'),
             f(ref.get('vti_gt_over_w', [None] * len(p['slip']))[i]), f(p['sinkage'][i], '%6.3f'), p['status'][i]))
     for t in s['towed']:
-        print('   towed (slip %s): DP/W %s, VTI %s, band %s, %s' % (
-            f(t['slip']), f(t['dp_over_w']), f(t.get('vti_dp_over_w')), t.get('band_dp_over_w'), t['status']))
+        band = t.get('band_dp_over_w') or [None, None]
+        print('   towed (slip %s): DP/W %s (%s), VTI %s, band [%s,%s], %s' % (
+            f(t['slip']), f(t['dp_over_w']), f(t['dp_over_w_std'], '%5.3f'), f(t.get('vti_dp_over_w')),
+            f(band[0], '%5.2f'), f(band[1], '%5.2f'), t['status']))
 
 
 if __name__ == '__main__':

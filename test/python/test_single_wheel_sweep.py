@@ -297,7 +297,8 @@ class SweepWithoutRos(unittest.TestCase):
         self.assertIn('  failed: ci20_slip0.7: overlap watchdog', out)
         self.assertIn('sweep: 8 runs in', out)
         self.assertIn(', 2 failed', out)  # the sunk wheels are results, not failures
-        self.assertRegex(out, r'ci100: CI 100 psi; VTI \(rigid\) N_c \d+\.\d\d')
+        self.assertRegex(out, r'ci100: CI 100.0 psi; VTI \(rigid\) N_c \d+\.\d\d')
+        self.assertRegex(out, r'towed \(slip -0.040\): DP/W -0.100 \(0.020\), VTI -0.\d+, band \[-0.\d\d,-0.\d\d\], ok')
 
     def test_summary(self):
         doc = self.first_summary
