@@ -20,8 +20,8 @@ if ! catkin_test_results --verbose "$DM_WS/build/test_results/dem_mobility"; the
   echo "catkin tests failed; full log: $DM_BUILD/run_tests.log"
   exit 1
 fi
-say "test: the sweep package (python unit tests, no ROS)"
-(cd "$DM_ROOT" && python3 -m unittest discover -s test/python -v)
+say "test: the sweep package, the sweeps and the wheel references (python unit tests, no ROS; one tiny wheel run through the core)"
+(cd "$DM_ROOT" && DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 -m unittest discover -s test/python -v)
 say "test: end-to-end road runs through roslaunch"
 DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 "$DM_ROOT/test/ros/test_road_runs.py"
 say "test: the cone index calibration sweep on tiny cases (roslaunch, bags, table, plots)"

@@ -104,6 +104,9 @@ class Sweep:
     check: callable (case, result) -> None if the result document is good, else why not ("no sample
       in the window"); applied after the generic checks (the document has no non-empty `error` and
       its `status` is not 'error').
+    accept_status: statuses a finished run may report besides 'ok' although its `error` says why
+      (e.g. ('sunk',): the wheel sank, a measurement, not a failure); such a run is good (check
+      still applies) and resume keeps it. 'error' and 'interrupted' cannot be accepted.
     outputs: callable case -> more files of a run to delete before it starts (e.g. its bag).
     env: extra environment variables (a dict, or a callable (case, outcome) -> dict).
     describe: callable outcome -> the text after a finished run's name (default 'ok' or
@@ -115,9 +118,12 @@ class Sweep:
 
     def __init__(self, cases, command, runs_dir, jobs=1, port=11411, timeout=None, check=None, outputs=None,
                  env=None, describe=None, progress='auto', poll=1.0, status_every=20.0,
-                 progress_marker='progress:', kill_grace=30.0, stream=None):
+                 progress_marker='progress:', kill_grace=30.0, stream=None, accept_status=()):
         if jobs < 1:
             raise ValueError('jobs must be >= 1')
+        self.accept_status = tuple(accept_status)
+        if set(self.accept_status) & {'error', 'interrupted'}:
+            raise ValueError('accept_status %r: error and interrupted are failures' % (self.accept_status,))
         names = [c.name for c in cases]
         if len(set(names)) != len(names):
             raise ValueError('case names repeat in %r' % names)
@@ -161,6 +167,8 @@ class Sweep:
         if not isinstance(result, dict):
             return 'the result file holds no mapping; see %s' % log
         err = result.get('error') or ''
+        if result.get('status') in self.accept_status:
+            err = ''  # it only explains the status
         if err or result.get('status') == 'error':
             return str(err) if err else 'the run failed; see %s' % log
         if self.check is not None:

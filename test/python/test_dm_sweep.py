@@ -44,6 +44,8 @@ if mode == 'fail':
     doc = {'status': 'error', 'error': 'the soil gave way'}
 if mode == 'empty':
     doc['value'] = None
+if mode == 'sunk':
+    doc.update(status='sunk', error='the wheel sank 0.3 m')
 with open(os.environ['DM_SWEEP_RESULT'], 'w') as fh:
     yaml.safe_dump(doc, fh)
 '''
@@ -296,6 +298,27 @@ class Resume(Base):
         # a check the old results fail: everything reruns
         s = self.sweep(cases, check=lambda case, res: 'too small' if res['value'] < 10 else None)
         self.assertEqual(s.resume(), [])
+
+
+    def test_accepted_status(self):
+        cases = dm_sweep.cases([{'mode': 'sunk', 'x': 1}, {'mode': 'ok', 'x': 2}])
+        plain = self.sweep(cases)
+        plain.run()
+        self.assertEqual([o.name for o in plain.failed()], ['modesunk_x1'])
+        self.assertIn('the wheel sank', plain.failed()[0].error)
+        os.remove(self.journal)
+        # a sunk wheel is a measurement: good, kept on resume, with its error in the result
+        s = self.sweep(cases, accept_status=('sunk',))
+        self.assertEqual([o.name for o in s.resume()], ['modesunk_x1', 'modeok_x2'])
+        s.run()
+        self.assertEqual(self.starts(), [])
+        self.assertEqual(s.exit_status(), 0)
+        self.assertEqual(s.outcomes[0].result['error'], 'the wheel sank 0.3 m')
+        # the sweep's check still applies to it
+        s = self.sweep(cases, accept_status=('sunk',), check=lambda case, res: 'no' if case['x'] == 1 else None)
+        self.assertEqual([o.name for o in s.resume()], ['modeok_x2'])
+        with self.assertRaises(ValueError):
+            self.sweep(cases, accept_status=('sunk', 'error'))
 
 
 class Progress(Base):
