@@ -86,6 +86,36 @@ SingleWheelRig::SingleWheelRig(const SingleWheelParams& p) : p_(p), wall0_(std::
   bin_ = std::make_unique<DemSoilBin>(p.bin, p.tire, 1);
 }
 
+SingleWheelRig::SingleWheelRig(const SingleWheelParams& p, const DemSoilBin& prepared)
+    : p_(p), wall0_(std::chrono::steady_clock::now()) {
+  const DemSoilParams& a = p.bin;
+  const DemSoilParams& b = prepared.params();
+  if (a.level.name != b.level.name || a.cohesion_factor != b.cohesion_factor || a.friction != b.friction ||
+      a.seed != b.seed || a.soil.file != b.soil.file || prepared.wheels() != 1 ||
+      prepared.tire().soil_mesh.faces.size() != p.tire.soil_mesh.faces.size() || prepared.tire().radius != p.tire.radius)
+    throw ConfigError(p.file + ": the prepared bin was made for another soil, level, seed or tire");
+  bin_ = std::make_unique<DemSoilBin>(prepared);
+  if (bin_->prepared()) {
+    Place();
+    phase_ = Phase::kLoad;
+  }
+}
+
+SingleWheelRig::SingleWheelRig(const SingleWheelRig& o)
+    : p_(o.p_),
+      bin_(std::make_unique<DemSoilBin>(*o.bin_)),
+      phase_(o.phase_),
+      wheel_(o.wheel_),
+      x0_(o.x0_), x_(o.x_), z_(o.z_), vz_(o.vz_), v_(o.v_), omega_(o.omega_), theta_(o.theta_),
+      t_phase_(o.t_phase_), dp_(o.dp_), torque_(o.torque_), accel_(o.accel_),
+      sunk_(o.sunk_),
+      s_dp_(o.s_dp_), s_torque_(o.s_torque_), s_fz_(o.s_fz_), s_sink_(o.s_sink_), s_omega_(o.s_omega_),
+      s_t0_(o.s_t0_), s_x0_(o.s_x0_), s_n_(o.s_n_),
+      samples_(o.samples_),
+      wall0_(o.wall0_),
+      prep_wall_time_(o.prep_wall_time_),
+      error_(o.error_) {}
+
 std::string SingleWheelRig::phase() const {
   switch (phase_) {
     case Phase::kPrepare: return bin_->phase();

@@ -75,6 +75,23 @@ SoilPreparation::SoilPreparation(DemSystem* s, int lid, double area, double park
                                  const std::string& who)
     : s_(s), lid_(lid), area_(area), park_z_(park_z), p_(p), who_(who) {}
 
+SoilPreparation::SoilPreparation(const SoilPreparation& o, DemSystem* s)
+    : s_(s),
+      lid_(o.lid_),
+      area_(o.area_),
+      park_z_(o.park_z_),
+      p_(o.p_),
+      who_(o.who_),
+      phase_(o.phase_),
+      phase_steps_(o.phase_steps_),
+      height_poured_(o.height_poured_),
+      height_consolidated_(o.height_consolidated_) {
+  if (o.hold_) {
+    hold_ = std::make_unique<LidHold>(*o.hold_);
+    hold_->Rebind(s);
+  }
+}
+
 const char* SoilPreparation::PhaseName(Phase p) {
   switch (p) {
     case Phase::kPour: return "pour";

@@ -196,6 +196,18 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
                                             "dem_soil bin (" + p.file + ")");
 }
 
+DemSoilBin::DemSoilBin(const DemSoilBin& o)
+    : p_(o.p_),
+      tire_(o.tire_),
+      dem_(std::make_unique<DemSystem>(*o.dem_)),
+      prep_(std::make_unique<SoilPreparation>(*o.prep_, dem_.get())),
+      tire_walls_(o.tire_walls_),
+      container_(o.container_),
+      centres_(o.centres_),
+      lid_(o.lid_),
+      wall_height_(o.wall_height_),
+      surface_(o.surface_) {}
+
 void DemSoilBin::PrepareStep() {
   prep_->Step();
   if (prep_->done()) surface_ = prep_->height_consolidated();  // (the particles are in the scene frame)

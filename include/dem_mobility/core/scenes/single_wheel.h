@@ -70,6 +70,14 @@ struct WheelSample {
 class SingleWheelRig final : public SoilRig {
  public:
   explicit SingleWheelRig(const SingleWheelParams& p);
+  /// A rig on a copy of a bin already prepared (or part-prepared) with the same soil: several slips
+  /// on one preparation. ConfigError when the bin's soil or level differ from p's.
+  SingleWheelRig(const SingleWheelParams& p, const DemSoilBin& prepared);
+  /// A copy of the rig as it stands (its own bin): for benchmarks and what-ifs from one state.
+  SingleWheelRig(const SingleWheelRig& o);
+  SingleWheelRig& operator=(const SingleWheelRig&) = delete;
+  /// OpenMP threads of the DEM from the next step on (results do not depend on it).
+  void set_threads(int threads) { bin_->dem().set_threads(threads); }
   const char* kind() const override { return "single_wheel"; }
   void Step() override;
   bool done() const override { return phase_ == Phase::kDone; }

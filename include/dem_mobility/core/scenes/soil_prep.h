@@ -50,6 +50,8 @@ class LidHold {
   /// 5 % of it.
   enum class Start { kReaches95Percent, kWithin5Percent };
   LidHold(DemSystem* s, int lid, double area, double pressure, double max_speed, Start start);
+  /// The same hold on another system (a copy of this one's).
+  void Rebind(DemSystem* s) { s_ = s; }
   void Step();
   bool holding() const { return held_ >= 0.0; }
   double held_time() const { return std::max(0.0, held_); }
@@ -85,6 +87,8 @@ class SoilPreparation {
   /// `who`: names the scene in error messages.
   SoilPreparation(DemSystem* s, int lid, double area, double park_z, const SoilPreparationParams& p,
                   const std::string& who);
+  /// A copy of `o` preparing `s` (a copy of o's system).
+  SoilPreparation(const SoilPreparation& o, DemSystem* s);
   /// One DEM step of the current phase (none for a phase of zero duration). SimulationError when
   /// the lid takes longer than `timeout` to reach its pressure, or to come free (the DEM's own
   /// watchdogs throw too).

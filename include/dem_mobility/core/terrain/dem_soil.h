@@ -74,6 +74,9 @@ class DemSoilBin {
   /// Builds the bin, pours the particles and adds `wheels` tire walls parked above the bin.
   /// ConfigError when a tire is wider than the bin.
   DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int wheels);
+  /// A copy (its own particles, walls and preparation): one prepared bin serves several runs.
+  DemSoilBin(const DemSoilBin& o);
+  DemSoilBin& operator=(const DemSoilBin&) = delete;
   /// One step of the preparation (pour, consolidate, retreat, release); SimulationError when it fails.
   void PrepareStep();
   bool prepared() const { return prep_->done(); }

@@ -1,0 +1,95 @@
+// The single-wheel rig's physics on the coarse level (6 cm particles; minutes): a wheel resting on
+// level soil carries its load; on CI 100 soil a towed wheel needs a pull and a driven one at 30 %
+// slip gives one; drawbar pull rises with slip and with soil strength. One preparation per soil
+// serves all its runs (copies of the prepared bin).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/scenes/single_wheel.h"
+
+namespace dem_mobility::core {
+namespace {
+
+// a shorter bin and window than the scene's: 0.9 m of travel, measured over its last 0.6 m
+SingleWheelParams Params(double ci, const std::string& drive, double slip) {
+  return SingleWheelParams::Read(YamlReader::LoadWithOverrides(
+      DM_CONFIG_DIR "/scenes/single_wheel.yaml",
+      {"fidelity=coarse", "threads=1", "cone_index=" + std::to_string(ci), "wheel.drive=" + drive,
+       "wheel.slip=" + std::to_string(slip), "levels.coarse.length=2.5", "carriage.window=[0.3, 0.9]"}));
+}
+
+// the prepared bin of each soil, made once
+const DemSoilBin& Prepared(double ci) {
+  static std::map<double, std::unique_ptr<DemSoilBin>> bins;
+  auto& b = bins[ci];
+  if (!b) {
+    const SingleWheelParams p = Params(ci, "slip", 0.0);
+    b = std::make_unique<DemSoilBin>(p.bin, p.tire, 1);
+    while (!b->prepared()) b->PrepareStep();
+  }
+  return *b;
+}
+
+struct RigRun {
+  double dp_w = 0.0, dp_w_std = 0.0, sinkage = 0.0, static_force = 0.0, static_speed = 0.0;
+  int samples = 0;
+};
+
+RigRun Drive(double ci, const std::string& drive, double slip) {
+  const SingleWheelParams p = Params(ci, drive, slip);
+  SingleWheelRig rig(p, Prepared(ci));
+  RigRun r;
+  // the last half of the rest under full load: the soil's mean force on the wheel
+  double fz = 0.0, vz = 0.0;
+  long n = 0, settle = 0;
+  const long settle_steps = std::lround(p.settle_time / p.bin.level.time_step);
+  while (!rig.done()) {
+    rig.Step();
+    if (rig.phase() == "settle" && ++settle > settle_steps / 2) {
+      fz += rig.wrench().force.z();
+      vz = std::max(vz, std::abs(rig.wheel().velocity.z()));
+      ++n;
+    }
+  }
+  EXPECT_FALSE(rig.sunk());
+  EXPECT_TRUE(rig.error().empty()) << rig.error();
+  const SingleWheelRig::Window w = rig.Measured();
+  r.dp_w = w.dp / p.Weight();
+  r.dp_w_std = w.dp_std / p.Weight();
+  r.sinkage = w.sinkage;
+  r.samples = w.samples;
+  r.static_force = n > 0 ? fz / n : 0.0;
+  r.static_speed = vz;
+  std::printf("CI %.0f %s slip %.2f: DP/W %.4f (std %.4f, %d samples), sinkage %.4f m; at rest %.1f N of %.1f N\n",
+              ci, drive.c_str(), slip, r.dp_w, r.dp_w_std, r.samples, r.sinkage, r.static_force, p.Weight());
+  return r;
+}
+
+TEST(SingleWheelRig, RestsOnTheSoilCarryingItsLoadAndPullsAtSlip) {
+  const double W = 1230.0 * 9.81;
+  const RigRun s0 = Drive(100, "slip", 0.0), s20 = Drive(100, "slip", 0.2), s30 = Drive(100, "slip", 0.3);
+  const RigRun towed = Drive(100, "towed", 0.0);
+  // at rest under its load the wheel is in equilibrium: the soil carries the load within 1 %
+  for (const RigRun& r : {s0, s20, s30, towed}) {
+    EXPECT_NEAR(r.static_force, W, 0.01 * W);
+    EXPECT_GT(r.samples, 40);
+    EXPECT_GT(r.sinkage, 0.0);
+  }
+  // a towed wheel needs a pull (positive motion resistance); a driven one at 30 % slip gives one
+  EXPECT_LT(towed.dp_w, 0.0);
+  EXPECT_GT(s30.dp_w, 0.0);
+  // drawbar pull rises with slip from 0 to 20 %
+  EXPECT_GT(s20.dp_w, s0.dp_w);
+}
+
+TEST(SingleWheelRig, DrawbarPullRisesWithConeIndex) {
+  const RigRun weak = Drive(50, "slip", 0.2), strong = Drive(100, "slip", 0.2);
+  EXPECT_GT(strong.dp_w, weak.dp_w);
+}
+
+}  // namespace
+}  // namespace dem_mobility::core
