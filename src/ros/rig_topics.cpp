@@ -132,7 +132,7 @@ visualization_msgs::Marker Coloured(const std::string& ns, int type, float r, fl
 /// The single-wheel rig (scenes/single_wheel.h): the soil's wrench on the wheel (wheel/wrench, in
 /// the frame `wheel`: at the wheel centre, axes parallel to the scene frame, on /tf), its samples
 /// (wheel/sample), its result (SingleWheelResult); the tire, the carriage and the lid as tools; the
-/// cross-section through the wheel's mid-plane.
+/// cross-section through the wheel's mid-plane (the far half of its track).
 class WheelTopics final : public RigTopics {
  public:
   void Advertise(ros::NodeHandle& nh) override {
@@ -246,9 +246,11 @@ class WheelTopics final : public RigTopics {
   }
 
   std::function<bool(const Eigen::Vector3d&)> Section(const SoilRig& rig) const override {
-    // the half y >= the wheel's y: a cut through the wheel's mid-plane, seen from -y
-    const double y = static_cast<const SingleWheelRig&>(rig).params().bin.origin.y();
-    return [y](const Eigen::Vector3d& x) { return x.y() >= y; };
+    // a cut through the wheel's mid-plane, seen from -y: the particles between the mid-plane and
+    // the tire's far side, so that the soil beside the track does not hide the rut's profile
+    const SingleWheelParams& p = static_cast<const SingleWheelRig&>(rig).params();
+    const double y0 = p.bin.origin.y(), y1 = y0 + 0.5 * p.tire.width;
+    return [y0, y1](const Eigen::Vector3d& x) { return x.y() >= y0 && x.y() <= y1; };
   }
 
   void AddTools(const SoilRig& rig, std::vector<visualization_msgs::Marker>* markers) override {
@@ -271,6 +273,16 @@ class WheelTopics final : public RigTopics {
     }
     const WheelState& w = wheel.wheel();
     const double R = tire.radius, half = 0.5 * tire.width;
+    // the prepared surface the sinkage is measured from, along the bin at the wheel's mid-plane
+    const SingleWheelParams& p = wheel.params();
+    Marker surface = Coloured("surface", Marker::LINE_LIST, 1.0f, 1.0f, 1.0f, 0.8f);
+    surface.scale.x = 0.012;
+    for (double x = 0.0; x < p.bin.level.length; x += 0.1) {  // dashed
+      surface.points.push_back(Point(p.bin.origin.x() + x, w.position.y(), bin.surface_height()));
+      surface.points.push_back(Point(p.bin.origin.x() + std::min(x + 0.05, p.bin.level.length), w.position.y(),
+                                     bin.surface_height()));
+    }
+    markers->push_back(std::move(surface));
     // the tire: the surface the soil touches, at the wheel's pose (see-through: the rut shows)
     if (tire_.points.empty()) {
       tire_ = Coloured("tire", Marker::TRIANGLE_LIST, 0.12f, 0.12f, 0.12f, 0.55f);
@@ -293,15 +305,16 @@ class WheelTopics final : public RigTopics {
     }
     SetPose(w.position, w.orientation, &spokes.pose);
     markers->push_back(std::move(spokes));
-    // the carriage: the axle, a fork over the tire and the beam back to the carriage; it moves
-    // with the wheel centre and does not turn
+    // the carriage: the axle, an arm over the tire from the far side (the wrench shows in front
+    // of it) and the beam back to the carriage; it moves with the wheel centre and does not turn
     const Eigen::Vector3d& c = w.position;
     Marker axle = Coloured("carriage", Marker::CYLINDER, 0.6f, 0.6f, 0.6f, 1.0f);
     axle.id = 0;
     const double yo = half + 0.12, top = R + 0.35;
-    SetPose(c, Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX())), &axle.pose);
+    SetPose(c + Eigen::Vector3d(0.0, 0.5 * yo, 0.0), Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX())),
+            &axle.pose);
     axle.scale.x = axle.scale.y = 0.07;
-    axle.scale.z = 2.0 * yo;
+    axle.scale.z = 1.5 * yo;
     markers->push_back(std::move(axle));
     Marker frame = Coloured("carriage", Marker::LINE_LIST, 1.0f, 0.6f, 0.1f, 1.0f);
     frame.id = 1;
@@ -310,21 +323,24 @@ class WheelTopics final : public RigTopics {
       frame.points.push_back(Point(c.x() + a.x(), c.y() + a.y(), c.z() + a.z()));
       frame.points.push_back(Point(c.x() + b.x(), c.y() + b.y(), c.z() + b.z()));
     };
-    for (double sy : {-yo, yo}) line({0, sy, 0}, {0, sy, top});               // the fork's legs
-    line({0, -yo, top}, {0, yo, top});                                      // its crown
-    line({0, 0, top}, {-0.9, 0, top});                                      // the beam to the carriage
-    line({-0.9, 0, top}, {-0.9, 0, top + 0.3});                             // the carriage's post
+    line({0, yo, 0}, {0, yo, top});             // the arm
+    line({0, yo, top}, {-0.9, yo, top});        // the beam to the carriage
+    line({-0.9, yo, top}, {-0.9, yo, top + 0.3});  // the carriage's post
     markers->push_back(std::move(frame));
   }
 
+  std::string StatusText(const SoilRig& rig) const override {
+    // the status line on two lines (where the run stands; what it measures now)
+    std::string line = rig.StatusLine();
+    const size_t at = line.find("  sinkage");
+    if (at != std::string::npos) line.replace(at, 2, "\n");
+    return line;
+  }
+
   Eigen::Vector3d StatusPosition(const SoilRig& rig) const override {
-    // above the carriage, moving with it (parked over the bin's middle while the soil is prepared)
-    const auto& wheel = static_cast<const SingleWheelRig&>(rig);
-    const SingleWheelParams& p = wheel.params();
-    const double above = p.bin.origin.z() + p.bin.level.soil_depth / p.bin.consolidation + 2.0 * p.tire.radius + 0.6;
-    if (!wheel.bin().prepared())
-      return p.bin.origin + Eigen::Vector3d(0.5 * p.bin.level.length, 0.0, above);
-    return wheel.wheel().position + Eigen::Vector3d(0.0, 0.0, p.tire.radius + 0.9);
+    // under the bin's floor, at its middle
+    const SingleWheelParams& p = static_cast<const SingleWheelRig&>(rig).params();
+    return p.bin.origin + Eigen::Vector3d(0.5 * p.bin.level.length, 0.0, -0.3);
   }
 
  private:

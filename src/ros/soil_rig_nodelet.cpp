@@ -188,7 +188,7 @@ class SoilRigNodelet : public nodelet::Nodelet {
     text.pose.position.z = at.z();
     text.scale.z = 0.12;
     text.color.r = text.color.g = text.color.b = text.color.a = 1.0f;
-    text.text = rig_->StatusLine();
+    text.text = topics_->StatusText(*rig_);
     arr->markers.push_back(text);
     for (auto& m : arr->markers) {
       m.header.stamp = stamp;

@@ -40,7 +40,9 @@ class RigTopics {
   /// The moving parts of one frame (terrain/tools; the nodelet stamps them, sets the frame and adds
   /// the status text): by default every moving wall at its pose.
   virtual void AddTools(const SoilRig& rig, std::vector<visualization_msgs::Marker>* markers);
-  /// Where the status text goes: by default under the container's floor.
+  /// The status text (by default the rig's StatusLine()) and where it goes (by default under the
+  /// container's floor).
+  virtual std::string StatusText(const SoilRig& rig) const { return rig.StatusLine(); }
   virtual Eigen::Vector3d StatusPosition(const SoilRig& rig) const;
 };
 
