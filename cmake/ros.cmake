@@ -11,6 +11,8 @@ add_message_files(DIRECTORY msg FILES
   MobilityResult.msg
   ConePenetration.msg
   ConeIndexResult.msg
+  WheelRigSample.msg
+  SingleWheelResult.msg
 )
 generate_messages(DEPENDENCIES std_msgs geometry_msgs)
 
@@ -29,6 +31,7 @@ if(CATKIN_ENABLE_TESTING)
   # every launch file parses and finds its packages and files
   roslaunch_add_file_check(launch/road_slope.launch)
   roslaunch_add_file_check(launch/cone_penetrometer.launch)
+  roslaunch_add_file_check(launch/single_wheel.launch)
   roslaunch_add_file_check(launch/replay.launch bag:=/tmp/run.bag)
   roslaunch_add_file_check(launch/components/vehicle.launch)
   roslaunch_add_file_check(launch/components/terrain.launch)

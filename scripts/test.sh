@@ -3,8 +3,9 @@
 #  1. the core GoogleTest suite with plain CMake (no ROS master),
 #  2. the catkin build of the whole package, then its catkin tests: roslaunch-check on every launch
 #     file and the rostest of the lock-step exchange (test/ros/road_scene.test),
-#  3. the end-to-end road runs through roslaunch (test/ros/test_road_runs.py) and the cone index
-#     calibration sweep on tiny cases (test/ros/test_cone_sweep.py),
+#  3. the end-to-end road runs through roslaunch (test/ros/test_road_runs.py), the cone index
+#     calibration sweep on tiny cases (test/ros/test_cone_sweep.py) and the single-wheel rig
+#     (test/ros/test_single_wheel.py),
 #  4. catkin_lint on the package (must report nothing).
 source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
@@ -26,6 +27,8 @@ say "test: end-to-end road runs through roslaunch"
 DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 "$DM_ROOT/test/ros/test_road_runs.py"
 say "test: the cone index calibration sweep on tiny cases (roslaunch, bags, table, plots)"
 python3 "$DM_ROOT/test/ros/test_cone_sweep.py"
+say "test: the single-wheel rig through roslaunch (tiny run: bag, result message and YAML; a bad slip)"
+python3 "$DM_ROOT/test/ros/test_single_wheel.py"
 say "test: catkin_lint"
 lint=$(cd "$DM_WS/src" && catkin_lint dem_mobility 2>&1 | grep -v rosdep)
 echo "$lint"

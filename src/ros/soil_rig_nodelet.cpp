@@ -1,8 +1,8 @@
-// dem_mobility/SoilRigNodelet: a soil rig scene (the cone penetrometer now, the single-wheel rig
-// next: any kind the core's rig registry knows), stepped here on a thread of its own, with the
-// particles as a PointCloud2 (coloured by plastic strain; a cross-section too), the container and
-// the moving walls as markers, the rig's own measurements and result as topics (RigTopics), /clock
-// and the result file. No physics here: the core computes, the nodelet converts and publishes.
+// dem_mobility/SoilRigNodelet: a soil rig scene (the cone penetrometer, the single-wheel rig: any
+// kind the core's rig registry knows), stepped here on a thread of its own, with the particles as a
+// PointCloud2 (coloured by plastic strain; a cross-section too), the container and the moving tools
+// as markers, the rig's own measurements and result as topics (RigTopics), /clock and the result
+// file. No physics here: the core computes, the nodelet converts and publishes.
 #include <atomic>
 #include <chrono>
 #include <thread>
@@ -169,33 +169,31 @@ class SoilRigNodelet : public nodelet::Nodelet {
     cloud->header.stamp = stamp;
     cloud->header.frame_id = frame_id_;
     cloud_.publish(cloud);
-    // the half y >= 0: a cross-section through the rig's axis, seen from -y (paper fig. 12)
+    // a cross-section through the tool (the half y >= 0 through the cone's axis, paper fig. 12;
+    // the half beyond the wheel's mid-plane), seen from -y
     auto section = boost::make_shared<sensor_msgs::PointCloud2>();
-    ToPointCloud(s, section.get(), [](const Eigen::Vector3d& x) { return x.y() >= 0.0; });
+    ToPointCloud(s, section.get(), topics_->Section(*rig_));
     section->header = cloud->header;
     section_.publish(section);
     auto arr = boost::make_shared<visualization_msgs::MarkerArray>();
-    auto add = [&](visualization_msgs::Marker m) {
-      m.header.stamp = stamp;
-      m.header.frame_id = frame_id_;
-      arr->markers.push_back(std::move(m));
-    };
-    static const float kColours[][4] = {{0.85f, 0.3f, 0.1f, 1.0f}, {0.7f, 0.7f, 0.7f, 1.0f}, {0.2f, 0.4f, 0.9f, 0.6f}};
-    int id = 0;
-    for (int w : rig_->moving_walls()) {
-      const float* c = kColours[std::min(id, 2)];
-      add(WallMarker(s.wall(w), s.wall(w).name, id++, c[0], c[1], c[2], c[3]));
-    }
+    topics_->AddTools(*rig_, &arr->markers);
     visualization_msgs::Marker text;
     text.ns = "status";
     text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
     text.action = visualization_msgs::Marker::ADD;
     text.pose.orientation.w = 1.0;
-    text.pose.position.z = -0.25;  // under the container's floor, clear of the tools and the soil
+    const Eigen::Vector3d at = topics_->StatusPosition(*rig_);  // clear of the tools and the soil
+    text.pose.position.x = at.x();
+    text.pose.position.y = at.y();
+    text.pose.position.z = at.z();
     text.scale.z = 0.12;
     text.color.r = text.color.g = text.color.b = text.color.a = 1.0f;
-    text.text = rig_->StatusLine();
-    add(text);
+    text.text = topics_->StatusText(*rig_);
+    arr->markers.push_back(text);
+    for (auto& m : arr->markers) {
+      m.header.stamp = stamp;
+      m.header.frame_id = frame_id_;
+    }
     tools_.publish(arr);
   }
 
