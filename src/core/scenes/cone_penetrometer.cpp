@@ -58,13 +58,16 @@ ConeParams ConeParams::Read(const YamlReader& y) {
   }
   if (!found) y.Fail("fidelity", "no level '" + fidelity + "' under levels: (" + names + ")");
   // the soil: f directly, or from a requested cone index through a calibration table
+  // (through the table of the level's particle size and the friction: CI(f) depends on both)
   const double f_file = y.Has("cohesion_factor") ? y.Double("cohesion_factor") : 1.0;
+  p.friction = y.DoubleIn("friction", 0.0, 2.0);
   if (y.Has("calibration")) p.calibration_file = y.ResolvePath(y.String("calibration"));
   if (y.Has("cone_index")) {
     p.requested_ci = y.Positive("cone_index");
     if (p.calibration_file.empty()) y.Fail("calibration", "is needed to turn cone_index into f");
     try {
-      p.cohesion_factor = CiCalibration::Load(p.calibration_file).CohesionFactor(p.requested_ci);
+      p.calibration = CiCalibration::LoadFor(p.calibration_file, p.level.particle_diameter, p.friction);
+      p.cohesion_factor = p.calibration->CohesionFactor(p.requested_ci);
     } catch (const ConfigError& e) {
       y.Fail("cone_index", e.what());
     }
@@ -76,7 +79,6 @@ ConeParams ConeParams::Read(const YamlReader& y) {
     y.Fail(y.Has("cone_index") ? "cone_index" : "cohesion_factor",
            "the cohesion factor f = " + detail::Concat(p.cohesion_factor) + " lies outside the paper's range [" +
                detail::Concat(kMinCohesionFactor) + ", " + detail::Concat(kMaxCohesionFactor) + "]");
-  p.friction = y.DoubleIn("friction", 0.0, 2.0);
   p.soil.diameter = p.level.particle_diameter;
   p.soil.cohesion_factor = p.cohesion_factor;
   p.soil.friction = p.friction;
@@ -343,10 +345,8 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
   f.Set("fidelity", r.level);
   f.Set("cohesion_factor", r.cohesion_factor);
   f.Set("friction", r.friction);
-  if (std::isfinite(r.requested_ci)) {
-    f.Set("requested_cone_index_psi", r.requested_ci);
-    f.Set("calibration", p.calibration_file);
-  }
+  if (std::isfinite(r.requested_ci)) f.Set("requested_cone_index_psi", r.requested_ci);
+  if (p.calibration) p.calibration->Describe(&f);  // which table f came from, and its error
   f.Set("cone_index_psi", r.ci_psi);
   f.Set("cone_index_std_psi", r.ci_std_psi);
   f.Set("cone_index_trend_psi_per_m", r.ci_trend_psi_per_m);

@@ -14,6 +14,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,7 +49,8 @@ struct ConeParams {
   double cohesion_factor = 1.0;    ///< f
   double friction = 0.1;           ///< inter-particle mu
   double requested_ci = std::numeric_limits<double>::quiet_NaN();  ///< when f came from a calibration
-  std::string calibration_file;
+  std::string calibration_file;    ///< `calibration`: a table or a directory of tables
+  std::optional<CiCalibration> calibration;  ///< the table f came from (for the level's particles and mu)
   int container_segments = 24;
   double solid_fraction = 0.58;    ///< poured solid fraction assumed for the particle count
   // the penetrometer (table 1)
