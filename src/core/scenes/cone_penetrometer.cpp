@@ -357,6 +357,9 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
   f.Set("particles", r.particles);
   f.Set("particle_diameter", p.level.particle_diameter);
   f.Set("container_diameter", p.level.container_diameter);
+  f.Set("soil_depth", p.level.soil_depth);
+  f.Set("cone_speed", p.level.cone_speed);
+  f.Set("seed", p.seed);
   f.Set("surface_height", r.surface_height);
   f.Set("bulk_density_poured", r.density_poured);
   f.Set("bulk_density_consolidated", r.density_consolidated);
