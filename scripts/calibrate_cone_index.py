@@ -124,7 +124,8 @@ def scene_level(scene, fidelity):
     except (KeyError, TypeError):
         raise ValueError('%s: no level %r under levels:' % (scene, fidelity))
     soil = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(scene)), doc['soil']))
-    keys = ['container_diameter', 'soil_depth', 'cone_speed', 'time_step', 'ci_window', 'settle_time', 'hold_time']
+    keys = ['container_diameter', 'soil_depth', 'cone_speed', 'approach_speed', 'approach_depth', 'time_step',
+            'ci_window', 'settle_time', 'hold_time']
     return soil, float(level['particle_diameter']), {k: level[k] for k in keys if k in level}
 
 
@@ -289,8 +290,13 @@ def main():
         sys.exit('calibrate_cone_index: no scene file %s' % a.scene)
     if a.finest and not os.path.isfile(a.finest):
         sys.exit('calibrate_cone_index: no file %s (--finest)' % a.finest)
+    # the commit and the files' hashes as the runs start (a checkout changed during the sweep
+    # does not change what ran)
+    root = os.path.dirname(here)
+    commit = git_commit(root)
     try:
         soil_file, diameter, conditions = scene_level(a.scene, a.fidelity)
+        soil_sha, scene_sha = sha256(soil_file), sha256(a.scene)
     except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as e:
         sys.exit('calibrate_cone_index: %s' % e)
     if shutil.which('roslaunch') is None:
@@ -341,7 +347,6 @@ def main():
         sys.exit('calibrate_cone_index: interrupted; finished runs are in %s' % a.out)
     runs = [Run(o, a.out) for o in sweep.outcomes]
     fits = {}
-    commit, root = git_commit(os.path.dirname(here)), os.path.dirname(here)
     for mu in a.mu:
         done = sorted(((r.f, r.ci(), r.seed) for r in runs if r.mu == mu and r.ok()))
         points = mean_points([(f, ci) for f, ci, _ in done])
@@ -377,9 +382,9 @@ def main():
                 'commit': commit,
                 'seeds': sorted(set(sd for _, _, sd in done)),
                 'soil_file': os.path.relpath(soil_file, root),
-                'soil_sha256': sha256(soil_file),
+                'soil_sha256': soil_sha,
                 'scene_file': os.path.relpath(os.path.abspath(a.scene), root),
-                'scene_sha256': sha256(a.scene),
+                'scene_sha256': scene_sha,
                 'date': time.strftime('%Y-%m-%d'),
                 'conditions': conditions,
             },

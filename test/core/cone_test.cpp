@@ -50,6 +50,9 @@ TEST(ConeConfig, RefusesBadInputNamingTheKey) {
   ExpectRefused({"levels.coarse.soil_depth=1.0"}, {"ci_window", "too deep"});
   ExpectRefused({"cone_index=1000"}, {"cone_index", "outside the calibrated range"});
   ExpectRefused({"pid.kp=-1"}, {"pid.kp"});
+  ExpectRefused({"fidelity=coarse_cal", "levels.coarse_cal.approach_depth=0.8"},
+                {"levels.coarse_cal.approach_depth", "above the CI window"});
+  ExpectRefused({"levels.coarse.approach_speed=0.4"}, {"levels.coarse.approach_depth", "missing"});
 }
 
 TEST(ConeConfig, ConeIndexTurnsIntoFThroughTheTable) {

@@ -25,6 +25,10 @@ ConeLevel ReadLevel(const YamlReader& y, const std::string& name) {
   l.container_diameter = y.DoubleIn("container_diameter", 0.1, 20.0);
   l.soil_depth = y.DoubleIn("soil_depth", 0.05, 20.0);
   l.cone_speed = y.DoubleIn("cone_speed", 1e-3, 5.0);
+  if (y.Has("approach_depth") || y.Has("approach_speed")) {
+    l.approach_depth = y.DoubleIn("approach_depth", 0.0, 20.0);
+    l.approach_speed = y.DoubleIn("approach_speed", 1e-3, 5.0);
+  }
   l.time_step = y.DoubleIn("time_step", 1e-8, 1e-3);
   l.settle_time = y.DoubleIn("settle_time", 0.0, 100.0);
   l.hold_time = y.DoubleIn("hold_time", 0.0, 100.0);
@@ -130,6 +134,9 @@ ConeParams ConeParams::Read(const YamlReader& y) {
     y.Fail(where + ".ci_window", "ends at a tip depth of " + detail::Concat(l.ci_to) + " m, too deep for soil poured " +
                                      detail::Concat(l.soil_depth) + " m deep (it settles to about " +
                                      detail::Concat(0.7 * l.soil_depth) + " m)");
+  if (l.approach_speed > 0.0 && !(l.approach_depth < l.ci_from))
+    y.Fail(where + ".approach_depth", "must end above the CI window (" + detail::Concat(l.ci_from) +
+                                         " m): the window is penetrated at cone_speed");
   if (l.ci_from < p.cone_length)
     y.Fail(where + ".ci_window", "starts at a tip depth of " + detail::Concat(l.ci_from) +
                                      " m, before the cone's base (" + detail::Concat(p.cone_length) +
@@ -206,9 +213,24 @@ double ConePenetrometer::penetration_force() const {
   return dem_->wall(cone_).force.z() + dem_->wall(rod_).force.z();
 }
 
+void ConePenetrometer::Reference(double t, double* z, double* v) const {
+  const ConeLevel& l = p_.level;
+  const double s = t - t0_;
+  // at approach_speed over the start gap and down to approach_depth, then at cone_speed
+  const double d1 = l.approach_speed > 0.0 ? p_.start_gap + l.approach_depth : 0.0;
+  const double t1 = l.approach_speed > 0.0 ? d1 / l.approach_speed : 0.0;
+  if (s < t1) {
+    *z = z0_ - l.approach_speed * s;
+    *v = -l.approach_speed;
+  } else {
+    *z = z0_ - d1 - l.cone_speed * (s - t1);
+    *v = -l.cone_speed;
+  }
+}
+
 void ConePenetrometer::PlaceCone() {
   z_tip_ = z0_ = surface_ + p_.start_gap;
-  v_tip_ = -p_.level.cone_speed;
+  v_tip_ = p_.level.approach_speed > 0.0 ? -p_.level.approach_speed : -p_.level.cone_speed;
   t0_ = dem_->time();
   // the integral starts at the weight, so the cone does not sag when it is let go
   integral_ = p_.ki > 0.0 ? p_.cone_mass * 9.81 / p_.ki : 0.0;
@@ -219,7 +241,8 @@ void ConePenetrometer::PlaceCone() {
 void ConePenetrometer::StepCone() {
   // PID on the prescribed tip height, the soil's force from the last evaluation, semi-implicit Euler
   const double dt = p_.level.time_step, t = dem_->time() + dt;
-  const double z_ref = z0_ - p_.level.cone_speed * (t - t0_), v_ref = -p_.level.cone_speed;
+  double z_ref = 0.0, v_ref = 0.0;
+  Reference(t, &z_ref, &v_ref);
   const double e = z_ref - z_tip_, de = v_ref - v_tip_;
   integral_ += e * dt;
   const double actuator = p_.kp * e + p_.ki * integral_ + p_.kd * de;
@@ -261,7 +284,7 @@ void ConePenetrometer::StartPenetration() {
   PlaceCone();
   StepCone();  // cone walls to their start (a jump: the next step rebuilds the lists)
   z_tip_ = z0_;
-  v_tip_ = -p_.level.cone_speed;
+  v_tip_ = p_.level.approach_speed > 0.0 ? -p_.level.approach_speed : -p_.level.cone_speed;
   phase_ = Phase::kPenetrate;
 }
 
@@ -308,8 +331,10 @@ ConeResult ConePenetrometer::Result() const {
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
   r.speed_min = 1e30;
   r.speed_max = -1e30;
+  // the speed once the tip is in the soil (and past the approach, if any)
+  const double speed_from = std::max(d, p_.level.approach_speed > 0.0 ? p_.level.approach_depth + d : 0.0);
   for (const ConeSample& c : samples_) {
-    if (c.depth >= d) {
+    if (c.depth >= speed_from) {
       r.speed_min = std::min(r.speed_min, c.speed);
       r.speed_max = std::max(r.speed_max, c.speed);
     }
@@ -359,6 +384,10 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
   f.Set("container_diameter", p.level.container_diameter);
   f.Set("soil_depth", p.level.soil_depth);
   f.Set("cone_speed", p.level.cone_speed);
+  if (p.level.approach_speed > 0.0) {
+    f.Set("approach_speed", p.level.approach_speed);
+    f.Set("approach_depth", p.level.approach_depth);
+  }
   f.Set("seed", p.seed);
   f.Set("surface_height", r.surface_height);
   f.Set("bulk_density_poured", r.density_poured);
