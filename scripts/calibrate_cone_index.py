@@ -1,21 +1,27 @@
 #!/usr/bin/env python3
 """Cone index calibration sweep (paper section 3, figs. 13-14, table 3): runs the cone penetrometer
-scene through roslaunch (the launch file and nodelets a user runs) for every cohesion factor f and
-inter-particle friction mu, several runs at a time in parallel processes (each with its own ROS
-master), and writes into OUT:
+scene through roslaunch (the launch file and nodelets a user runs) for every cohesion factor f,
+inter-particle friction mu and seed, several runs at a time in parallel processes (each with its
+own ROS master), and writes into OUT:
 
-  runs/mu<mu>_f<f>.bag (+ .result.yaml, .log)   every run: its bag, result and console output
-  ci_vs_time_mu<mu>.png                          CI versus time per run (fig. 13)
-  ci_vs_f.png                                    CI versus f for every mu (fig. 14), with the fit
-  cone_index_mu<mu>.yaml                         the cubic fit f(CI) and a table CI -> f (table 3),
-                                                 the file soil scenes read (`cone_index:`)
-  sweep.yaml                                     every run's outcome, failures included
+  runs/mu<mu>_f<f>_s<seed>.bag (+ .result.yaml, .log)  every run: its bag, result and console output
+  ci_vs_time_mu<mu>.png                 CI versus time per run (fig. 13)
+  ci_vs_f.png                           CI versus f for every mu (fig. 14): runs, means, the fit
+  cone_index_mu<mu>_d<d>.yaml           the table CI -> f (table 3) for the level's particle
+                                        diameter d: the cubic fit f(CI) of the mean CI per f, the
+                                        mean and scatter over the seeds per f, every run, the
+                                        provenance (commit, seeds, soil file sha256, scene, date,
+                                        conditions) and the level's error against the finest level
+                                        (--finest); the file soil scenes read (`cone_index:`)
+  sweep.yaml                            every run's outcome, failures included
 
-    python3 scripts/calibrate_cone_index.py --fidelity coarse --jobs 2 --out results/calibration
+    python3 scripts/calibrate_cone_index.py --fidelity coarse --seeds 1,2,3 --jobs 1 \
+        --out results/calibration --install config/calibration
 
 A failed run is reported and the others are kept; the exit status is 1 if any run failed.
 """
 import argparse
+import hashlib
 import math
 import os
 import shutil
@@ -41,8 +47,15 @@ def floats(text):
         raise argparse.ArgumentTypeError('expected a comma-separated list of numbers, got %r' % text)
 
 
-def case_name(mu, f):
-    return 'mu%g_f%g' % (mu, f)
+def ints(text):
+    try:
+        return [int(v) for v in text.split(',') if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError('expected a comma-separated list of whole numbers, got %r' % text)
+
+
+def case_name(mu, f, seed):
+    return 'mu%g_f%g_s%d' % (mu, f, seed)
 
 
 def bag_path(out, name):
@@ -54,7 +67,7 @@ class Run:
 
     def __init__(self, outcome, out):
         self.outcome = outcome
-        self.mu, self.f = outcome.case['mu'], outcome.case['f']
+        self.mu, self.f, self.seed = outcome.case['mu'], outcome.case['f'], outcome.case['seed']
         self.name = outcome.name
         self.bag = bag_path(out, self.name)
         self.result_file, self.log = outcome.result_file, outcome.log
@@ -66,6 +79,89 @@ class Run:
 
     def ci(self):
         return float(self.result['cone_index_psi'])
+
+
+def mean_points(runs):
+    """Per f: (f, mean CI, sample standard deviation over the seeds (None for one seed), seeds)."""
+    by_f = {}
+    for f, ci in runs:
+        by_f.setdefault(f, []).append(ci)
+    out = []
+    for f in sorted(by_f):
+        v = by_f[f]
+        m = sum(v) / len(v)
+        sd = math.sqrt(sum((x - m) ** 2 for x in v) / (len(v) - 1)) if len(v) > 1 else None
+        out.append((f, m, sd, len(v)))
+    return out
+
+
+def sha256(path):
+    h = hashlib.sha256()
+    with open(path, 'rb') as fh:
+        for block in iter(lambda: fh.read(1 << 16), b''):
+            h.update(block)
+    return h.hexdigest()
+
+
+def git_commit(root):
+    """The checkout's commit, with '-dirty' when tracked files differ from it."""
+    try:
+        head = subprocess.run(['git', '-C', root, 'rev-parse', 'HEAD'], stdout=subprocess.PIPE,
+                              stderr=subprocess.DEVNULL, universal_newlines=True, check=True).stdout.strip()
+        dirty = subprocess.run(['git', '-C', root, 'diff', '--quiet', 'HEAD', '--'],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode != 0
+        return head + ('-dirty' if dirty else '')
+    except (OSError, subprocess.CalledProcessError):
+        return 'unknown (not a git checkout)'
+
+
+def scene_level(scene, fidelity):
+    """The soil file and the level's conditions from the scene file."""
+    with open(scene) as fh:
+        doc = yaml.safe_load(fh)
+    try:
+        level = doc['levels'][fidelity]
+    except (KeyError, TypeError):
+        raise ValueError('%s: no level %r under levels:' % (scene, fidelity))
+    soil = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(scene)), doc['soil']))
+    keys = ['container_diameter', 'soil_depth', 'cone_speed', 'approach_speed', 'approach_depth', 'time_step',
+            'ci_window', 'settle_time', 'hold_time']
+    return soil, float(level['particle_diameter']), {k: level[k] for k in keys if k in level}
+
+
+def error_vs_finest(finest, table, fidelity, mu, d):
+    """The table's relative CI error against the finest level's runs (a YAML file: level, friction,
+    particle_diameter, points {f, ci}, source), at the f values inside the table; without one, a
+    note that no finer level was run."""
+    if not finest:
+        return {'level': fidelity, 'note': 'only this level (%s) was run for this table: its error against a finer '
+                                           'level is not known' % fidelity}
+    with open(finest) as fh:
+        ref = yaml.safe_load(fh)
+    if abs(float(ref['friction']) - mu) > 1e-9:
+        raise ValueError('%s: friction %g, not the table\'s %g' % (finest, ref['friction'], mu))
+    fs, cis = [float(v) for v in ref['points']['f']], [float(v) for v in ref['points']['ci']]
+    tf, tci = [r[1] for r in table], [r[0] for r in table]
+    rel = []
+    for f, ci in zip(fs, cis):
+        if tf[0] <= f <= tf[-1]:
+            rel.append((f, ci, float(interp(f, tf, tci)), ))
+    if not rel:
+        return {'level': ref['level'], 'note': 'the finest level\'s runs (%s) lie outside the table\'s f range' % finest}
+    errs = [(t - c) / c for f, c, t in rel]
+    note = ('mean over f of (table CI - %s CI) / %s CI; %s; from %s: %s' %
+            (ref['level'], ref['level'], ', '.join('f %g: table %.1f psi vs %.1f psi (%+.0f %%)' % (f, t, c, 100 * (t - c) / c)
+                                                   for f, c, t in rel),
+             os.path.basename(finest), ref.get('source', '')))
+    return {'level': ref['level'], 'relative': round(sum(errs) / len(errs), 4), 'note': note}
+
+
+def interp(x, xs, ys):
+    for k in range(1, len(xs)):
+        if x <= xs[k]:
+            s = (x - xs[k - 1]) / (xs[k] - xs[k - 1])
+            return ys[k - 1] + s * (ys[k] - ys[k - 1])
+    return ys[-1]
 
 
 def fit(points, table_ci):
@@ -122,7 +218,7 @@ def plots(runs, out, mus, fits):
         fig, ax = plt.subplots(figsize=(8, 5))
         for r in sorted(done, key=lambda r: r.f):
             h = r.result['history']
-            ax.plot(h['t'], h['ci_psi'], lw=1.2, label='f = %g%s' % (r.f, '' if r.ok() else ' (failed)'))
+            ax.plot(h['t'], h['ci_psi'], lw=1.2, label='f = %g, seed %d%s' % (r.f, r.seed, '' if r.ok() else ' (failed)'))
         ax.set_xlabel('time since the cone started [s]')
         ax.set_ylabel('cone index [psi]')
         ax.set_title('CI versus time, mu = %g (paper fig. 13)' % mu)
@@ -138,7 +234,10 @@ def plots(runs, out, mus, fits):
         pts = sorted((r.f, r.ci()) for r in runs if r.mu == mu and r.ok())
         if not pts:
             continue
-        line = ax.plot([p[0] for p in pts], [p[1] for p in pts], 'o', label='runs, mu = %g' % mu)[0]
+        line = ax.plot([p[0] for p in pts], [p[1] for p in pts], 'o', mfc='none', label='runs, mu = %g' % mu)[0]
+        mp = mean_points(pts)
+        ax.errorbar([p[0] for p in mp], [p[1] for p in mp], yerr=[p[2] or 0.0 for p in mp], fmt='s',
+                    color=line.get_color(), capsize=3, label='mean and std over the seeds, mu = %g' % mu)
         if mu in fits:
             table = fits[mu][1]
             ax.plot([t[1] for t in table], [t[0] for t in table], '-', color=line.get_color(),
@@ -165,6 +264,11 @@ def main():
     ap.add_argument('--fidelity', default='coarse', help='level of the scene file (default coarse)')
     ap.add_argument('--f', type=floats, default=floats('0.05,0.3,1.5,5,12'), help='cohesion factors')
     ap.add_argument('--mu', type=floats, default=floats('0.1,0.05'), help='inter-particle friction coefficients')
+    ap.add_argument('--seeds', type=ints, default=ints('1'),
+                    help='seeds of the poured lattice, each f and mu is run with every one (default 1; a table '
+                         'point wants at least 3)')
+    ap.add_argument('--finest', help="YAML of the finest level's runs (level, friction, particle_diameter, "
+                                     "points: {f: [...], ci: [...]}, source) to give the table its error against")
     ap.add_argument('--jobs', type=int, default=2, help='runs at a time (default 2: one per core)')
     ap.add_argument('--dem-threads', type=int, default=1, help='OpenMP threads per run (default 1)')
     ap.add_argument('--cloud-rate', type=float, default=5.0, help='particle clouds per simulated second in each bag')
@@ -172,15 +276,29 @@ def main():
     ap.add_argument('--port', type=int, default=11411, help='first ROS master port (one per parallel run)')
     ap.add_argument('--table-ci', type=floats, default=floats(','.join(str(c) for c, _ in PAPER_TABLE)),
                     help="cone indices of the table's rows (the paper's by default)")
-    ap.add_argument('--install', help='also copy the mu = 0.1 table to this file (e.g. config/calibration/cone_index_mu0.1.yaml)')
+    ap.add_argument('--install', help='also copy the tables into this directory (e.g. config/calibration), or '
+                                      'the mu = 0.1 table to this file')
     ap.add_argument('--resume', action='store_true',
-                    help='keep the runs already in OUT that succeeded with the same level, f and mu (rerun the rest)')
+                    help='keep the runs already in OUT that succeeded with the same level, f, mu and seed (rerun the rest)')
     ap.add_argument('--out', default='results/calibration')
     a = ap.parse_args()
     if a.jobs < 1 or a.dem_threads < 1:
         sys.exit('calibrate_cone_index: --jobs and --dem-threads must be >= 1')
+    if not a.seeds or len(set(a.seeds)) != len(a.seeds) or min(a.seeds) < 0:
+        sys.exit('calibrate_cone_index: --seeds must list distinct seeds >= 0')
     if not os.path.isfile(a.scene):
         sys.exit('calibrate_cone_index: no scene file %s' % a.scene)
+    if a.finest and not os.path.isfile(a.finest):
+        sys.exit('calibrate_cone_index: no file %s (--finest)' % a.finest)
+    # the commit and the files' hashes as the runs start (a checkout changed during the sweep
+    # does not change what ran)
+    root = os.path.dirname(here)
+    commit = git_commit(root)
+    try:
+        soil_file, diameter, conditions = scene_level(a.scene, a.fidelity)
+        soil_sha, scene_sha = sha256(soil_file), sha256(a.scene)
+    except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as e:
+        sys.exit('calibrate_cone_index: %s' % e)
     if shutil.which('roslaunch') is None:
         sys.exit('calibrate_cone_index: roslaunch not found: source the catkin workspace (devel/setup.bash) first')
     if subprocess.run(['rospack', 'find', 'dem_mobility'], stdout=subprocess.DEVNULL,
@@ -189,14 +307,15 @@ def main():
                  'source the catkin workspace (devel/setup.bash) that built it first')
     os.makedirs(os.path.join(a.out, 'runs'), exist_ok=True)
     try:
-        cases = dm_sweep.grid([('mu', a.mu), ('f', a.f)], name=lambda p: case_name(p['mu'], p['f']))
+        cases = dm_sweep.grid([('mu', a.mu), ('f', a.f), ('seed', a.seeds)],
+                              name=lambda p: case_name(p['mu'], p['f'], p['seed']))
     except ValueError as e:
         sys.exit('calibrate_cone_index: %s' % e)
 
     def command(case, run):
         return ['roslaunch', '-p', str(run.port), 'dem_mobility', 'cone_penetrometer.launch',
                 'scene:=' + os.path.abspath(a.scene), 'fidelity:=' + a.fidelity, 'f:=%g' % case['f'],
-                'mu:=%g' % case['mu'], 'dem_threads:=%d' % a.dem_threads,
+                'mu:=%g' % case['mu'], 'seed:=%d' % case['seed'], 'dem_threads:=%d' % a.dem_threads,
                 'bag:=' + os.path.abspath(bag_path(a.out, case.name)), 'cloud_rate:=%g' % a.cloud_rate]
 
     def check(case, result):
@@ -206,10 +325,10 @@ def main():
         return 'CI %.1f psi' % float(run.result['cone_index_psi']) if run.ok else 'FAILED: ' + run.error
 
     def same_run(case, old):
-        """A kept run was made with the same level, f and mu."""
+        """A kept run was made with the same level, f, mu and seed."""
         try:
             return (old.get('fidelity') == a.fidelity and abs(old.get('cohesion_factor', -1) - case['f']) < 1e-12
-                    and abs(old.get('friction', -1) - case['mu']) < 1e-12)
+                    and abs(old.get('friction', -1) - case['mu']) < 1e-12 and old.get('seed') == case['seed'])
         except TypeError:
             return False
 
@@ -219,8 +338,9 @@ def main():
     if a.resume:
         sweep.resume(accept=same_run)
     t0 = time.time()
-    print('sweep: %d runs (f %s x mu %s), level %s, %d at a time' %
-          (len(cases), ','.join('%g' % f for f in a.f), ','.join('%g' % m for m in a.mu), a.fidelity, a.jobs), flush=True)
+    print('sweep: %d runs (f %s x mu %s x seeds %s), level %s, %d at a time' %
+          (len(cases), ','.join('%g' % f for f in a.f), ','.join('%g' % m for m in a.mu),
+           ','.join('%d' % s for s in a.seeds), a.fidelity, a.jobs), flush=True)
     try:
         sweep.run(t0)
     except KeyboardInterrupt:
@@ -228,45 +348,83 @@ def main():
     runs = [Run(o, a.out) for o in sweep.outcomes]
     fits = {}
     for mu in a.mu:
-        pts = sorted((r.f, r.ci()) for r in runs if r.mu == mu and r.ok())
-        if len(pts) < 2:
-            print('mu %g: %d successful run(s): no fit' % (mu, len(pts)))
+        done = sorted(((r.f, r.ci(), r.seed) for r in runs if r.mu == mu and r.ok()))
+        points = mean_points([(f, ci) for f, ci, _ in done])
+        if len(points) < 2:
+            print('mu %g: successful runs at %d f value(s): no fit' % (mu, len(points)))
             continue
-        fits[mu] = fit(pts, a.table_ci)
+        fits[mu] = fit([(f, m) for f, m, _, _ in points], a.table_ci)
         cubic, table, band, method = fits[mu]
+        # the scatter of every run about the table (seeds included), relative in CI
+        res = [(ci - interp(f, [t[1] for t in table], [t[0] for t in table])) / ci
+               for f, ci, _ in done if table[0][1] <= f <= table[-1][1]]
+        band = math.sqrt(sum(r * r for r in res) / len(res)) if res else 0.0
+        pts = {'f': [f for f, _, _, _ in points], 'ci_mean': [round(m, 3) for _, m, _, _ in points]}
+        if any(n > 1 for _, _, _, n in points):
+            pts['ci_std'] = [round(sd, 3) if sd is not None else 0.0 for _, _, sd, _ in points]
+        pts['seeds'] = [n for _, _, _, n in points]
+        try:
+            err = error_vs_finest(a.finest, table, a.fidelity, mu, diameter)
+        except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as e:
+            sys.exit('calibrate_cone_index: --finest: %s' % e)
         doc = {
+            'particle_diameter': diameter,
             'friction': mu,
             'fidelity': a.fidelity,
-            'scene': os.path.relpath(os.path.abspath(a.scene), os.path.dirname(here)),
-            'date': time.strftime('%Y-%m-%d'),
-            'method': method,
+            'method': method + '; fitted to the mean CI over the seeds at each f',
             'cubic': cubic,
             'band': round(band, 4),
             'table': [[round(c, 2), round(v, 4)] for c, v in table],
-            'runs': [[r.f, round(r.ci(), 3)] for r in sorted(runs, key=lambda r: r.f) if r.mu == mu and r.ok()],
+            'points': pts,
+            'runs': {'f': [f for f, _, _ in done], 'seed': [sd for _, _, sd in done],
+                     'ci': [round(ci, 3) for _, ci, _ in done]},
+            'provenance': {
+                'commit': commit,
+                'seeds': sorted(set(sd for _, _, sd in done)),
+                'soil_file': os.path.relpath(soil_file, root),
+                'soil_sha256': soil_sha,
+                'scene_file': os.path.relpath(os.path.abspath(a.scene), root),
+                'scene_sha256': scene_sha,
+                'date': time.strftime('%Y-%m-%d'),
+                'conditions': conditions,
+            },
+            'error_vs_finest': err,
         }
-        path = os.path.join(a.out, 'cone_index_mu%g.yaml' % mu)
+        path = os.path.join(a.out, 'cone_index_mu%g_d%g.yaml' % (mu, diameter))
         with open(path, 'w') as fh:
-            fh.write('# Cone index calibration: CI [psi] -> cohesion factor f at mu = %g (level %s).\n'
-                     '# cubic: f = c0 CI^3 + c1 CI^2 + c2 CI + c3; table: [CI, f] rows; band: relative rms\n'
-                     '# CI scatter of the runs about the table; runs: [f, CI] measured.\n'
-                     '# Written by scripts/calibrate_cone_index.py.\n' % (mu, a.fidelity))
-            yaml.safe_dump(doc, fh, default_flow_style=None, sort_keys=False)
+            fh.write('# Cone index calibration: CI [psi] -> cohesion factor f at mu = %g for particles of %g m\n'
+                     '# (level %s), written by scripts/calibrate_cone_index.py.\n'
+                     '# cubic: f = c0 CI^3 + c1 CI^2 + c2 CI + c3, fitted to the mean CI per f; table: [CI, f]\n'
+                     '# rows; band: relative rms CI scatter of every run about the table; points: per f, the\n'
+                     '# mean CI over the seeds, its sample std and the number of seeds; runs: every run (f,\n'
+                     '# seed, CI); provenance: where it came from; error_vs_finest: the level\'s CI error against\n'
+                     '# the finest level run.\n' % (mu, diameter, a.fidelity))
+            yaml.safe_dump(doc, fh, default_flow_style=None, sort_keys=False, width=110)
         print('mu %g: %s; band %.1f %%; table -> %s' % (mu, method, 100 * band, path))
+        print('   f        CI mean [psi]  std over seeds  seeds')
+        for f, m, sd, n in points:
+            print('   %-8g %8.1f      %s      %d' % (f, m, '%8.2f' % sd if sd is not None else '       -', n))
         print('   CI [psi]   f (ours)   f (paper, mu 0.1)')
         paper = dict(PAPER_TABLE)
         for c, v in table:
             print('   %7.1f   %8.3f   %s' % (c, v, '%.2f' % paper[c] if c in paper else '-'))
-        if a.install and abs(mu - 0.1) < 1e-12:
-            os.makedirs(os.path.dirname(os.path.abspath(a.install)), exist_ok=True)
-            shutil.copyfile(path, a.install)
-            print('   installed as %s' % a.install)
+        if a.install:
+            if os.path.isdir(a.install):
+                dest = os.path.join(a.install, os.path.basename(path))
+            elif abs(mu - 0.1) < 1e-12:
+                dest = a.install
+                os.makedirs(os.path.dirname(os.path.abspath(dest)), exist_ok=True)
+            else:
+                continue
+            shutil.copyfile(path, dest)
+            print('   installed as %s' % dest)
     for p in plots(runs, a.out, a.mu, fits):
         print('plot: %s' % p)
     failed = [r for r in runs if not r.ok()]
     with open(os.path.join(a.out, 'sweep.yaml'), 'w') as fh:
         yaml.safe_dump({'fidelity': a.fidelity, 'wall_time': round(time.time() - t0, 1), 'jobs': a.jobs,
-                        'runs': [{'f': r.f, 'mu': r.mu, 'ok': r.ok(),
+                        'seeds': a.seeds,
+                        'runs': [{'f': r.f, 'mu': r.mu, 'seed': r.seed, 'ok': r.ok(),
                                   'cone_index_psi': r.ci() if r.ok() else None,
                                   'wall_time': round((r.end or 0) - (r.start or 0), 1),
                                   'error': r.error, 'bag': r.bag} for r in runs]}, fh, sort_keys=False)

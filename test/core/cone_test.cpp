@@ -4,9 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <thread>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/scenes/calibration.h"
@@ -46,20 +50,93 @@ TEST(ConeConfig, RefusesBadInputNamingTheKey) {
   ExpectRefused({"levels.coarse.soil_depth=1.0"}, {"ci_window", "too deep"});
   ExpectRefused({"cone_index=1000"}, {"cone_index", "outside the calibrated range"});
   ExpectRefused({"pid.kp=-1"}, {"pid.kp"});
+  ExpectRefused({"fidelity=coarse_cal", "levels.coarse_cal.approach_depth=0.8"},
+                {"levels.coarse_cal.approach_depth", "above the CI window"});
+  ExpectRefused({"levels.coarse.approach_speed=0.4"}, {"levels.coarse.approach_depth", "missing"});
 }
 
 TEST(ConeConfig, ConeIndexTurnsIntoFThroughTheTable) {
-  const CiCalibration cal = CiCalibration::Load(DM_CONFIG_DIR "/calibration/cone_index_mu0.1.yaml");
+  // the scene names the directory; the table is the one of the level's particles and friction
+  const ConeParams base = Cone({});
+  const CiCalibration cal = CiCalibration::LoadFor(DM_CONFIG_DIR "/calibration", base.level.particle_diameter,
+                                                   base.friction);
   const double ci = 0.5 * (cal.ci.front() + cal.ci.back());
   const ConeParams p = Cone({"cone_index=" + std::to_string(ci)});
   EXPECT_DOUBLE_EQ(p.cohesion_factor, cal.CohesionFactor(ci));
   EXPECT_DOUBLE_EQ(p.soil.cohesion_factor, p.cohesion_factor);
   EXPECT_DOUBLE_EQ(p.requested_ci, ci);
+  ASSERT_TRUE(p.calibration.has_value());
+  EXPECT_EQ(p.calibration->file, cal.file);
+  // the result says which table it used, for which particles, and the table's error
+  const std::string text = ConeResultFile(ConeResult(), p).Text();
+  for (const char* key : {"calibration_table:", "calibration_level:", "calibration_particle_diameter:",
+                          "calibration_error_vs_finest:"})
+    EXPECT_NE(text.find(key), std::string::npos) << key << " not in:\n" << text;
+  EXPECT_NE(text.find(cal.file), std::string::npos);
+  // without cone_index no table is used, and the result names none
+  EXPECT_FALSE(Cone({"cohesion_factor=2"}).calibration.has_value());
+}
+
+// A level whose particles no table was made for: the cone index is refused, naming the key and
+// both sizes (the level's and the tables').
+TEST(ConeConfig, ConeIndexRefusedWithoutATableForTheLevelsParticles) {
+  ExpectRefused({"fidelity=medium", "cone_index=100"}, {"cone_index", "particle_diameter", "0.05", "0.06"});
+  ExpectRefused({"friction=0.3", "cone_index=100"}, {"cone_index", "friction 0.3", "mu 0.1"});
+}
+
+// A table as the sweep writes it, with what the test changes substituted.
+std::string TableText(double d, double mu, const std::string& extra = "") {
+  return "particle_diameter: " + std::to_string(d) + "\nfriction: " + std::to_string(mu) +
+         "\nfidelity: coarse\ncubic: [0, 0, 0.1, -2]\nband: 0.02\n"
+         "table: [[30, 1.0], [50, 3.0], [100, 8.0]]\n"
+         "points: {f: [1.0, 3.0, 8.0], ci_mean: [30, 50, 100], ci_std: [1.0, 2.0, 3.0], seeds: [3, 3, 3]}\n"
+         "runs: {f: [1, 1, 1], seed: [1, 2, 3], ci: [29, 30, 31]}\n"
+         "provenance:\n  commit: abc1234\n  seeds: [1, 2, 3]\n  soil_file: config/soils/nominal_clay.yaml\n"
+         "  soil_sha256: " + std::string(64, 'a') + "\n  scene_file: config/scenes/cone_penetrometer.yaml\n"
+         "  date: '2026-11-29'\n  conditions: {container_diameter: 1.2, soil_depth: 1.6, cone_speed: 0.4, "
+         "ci_window: [0.78, 0.92]}\n"
+         "error_vs_finest: {level: medium, relative: 0.3, note: measured}\n" + extra;
+}
+
+std::string Without(std::string text, const std::string& line) {
+  const size_t k = text.find(line);
+  EXPECT_NE(k, std::string::npos) << line;
+  return text.erase(k, text.find('\n', k) - k + 1);
+}
+
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    path = std::filesystem::temp_directory_path() /
+           ("dm_calibration_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() { std::filesystem::remove_all(path); }
+  std::string Write(const std::string& name, const std::string& text) const {
+    const std::string p = (path / name).string();
+    std::ofstream(p) << text;
+    return p;
+  }
+};
+
+std::string Refusal(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "accepted";
+  return "";
+}
+
+void ExpectWords(const std::string& m, const std::vector<std::string>& words) {
+  for (const std::string& w : words) EXPECT_NE(m.find(w), std::string::npos) << "'" << w << "' not in: " << m;
 }
 
 TEST(CiCalibration, InterpolatesBothWaysAndRefusesOutsideItsRange) {
-  const CiCalibration c = CiCalibration::Read(YamlReader::FromString(
-      "friction: 0.1\ncubic: [0, 0, 0.1, -2]\ntable: [[30, 1.0], [50, 3.0], [100, 8.0]]\n", "cal.yaml"));
+  const CiCalibration c = CiCalibration::Read(YamlReader::FromString(TableText(0.06, 0.1), "cal.yaml"));
   EXPECT_DOUBLE_EQ(c.CohesionFactor(30), 1.0);
   EXPECT_DOUBLE_EQ(c.CohesionFactor(40), 2.0);
   EXPECT_DOUBLE_EQ(c.CohesionFactor(75), 5.5);
@@ -67,9 +144,131 @@ TEST(CiCalibration, InterpolatesBothWaysAndRefusesOutsideItsRange) {
   EXPECT_DOUBLE_EQ(c.ConeIndex(c.CohesionFactor(63.0)), 63.0);
   EXPECT_THROW(c.CohesionFactor(29.9), ConfigError);
   EXPECT_THROW(c.ConeIndex(8.5), ConfigError);
-  EXPECT_THROW(CiCalibration::Read(YamlReader::FromString(
-                   "friction: 0.1\ncubic: [0, 0, 0, 1]\ntable: [[30, 3.0], [50, 1.0]]\n", "bad.yaml")),
-               ConfigError);  // f falling with CI
+  std::string falling = TableText(0.06, 0.1);
+  falling.replace(falling.find("[[30, 1.0], [50, 3.0]"), 21, "[[30, 3.0], [50, 1.0]");
+  EXPECT_THROW(CiCalibration::Read(YamlReader::FromString(falling, "bad.yaml")), ConfigError);  // f falls with CI
+}
+
+TEST(CiCalibration, ReadsParticleSizePointsAndProvenance) {
+  const CiCalibration c = CiCalibration::Read(YamlReader::FromString(TableText(0.06, 0.1), "cal.yaml"));
+  EXPECT_DOUBLE_EQ(c.particle_diameter, 0.06);
+  EXPECT_EQ(c.level, "coarse");
+  ASSERT_EQ(c.points.size(), 3u);
+  EXPECT_DOUBLE_EQ(c.points[1].ci_mean, 50.0);
+  EXPECT_DOUBLE_EQ(c.points[1].ci_std, 2.0);
+  EXPECT_EQ(c.MinSeeds(), 3);
+  EXPECT_EQ(c.seeds, (std::vector<int>{1, 2, 3}));
+  EXPECT_EQ(c.error_vs_finest.level, "medium");
+  EXPECT_DOUBLE_EQ(c.error_vs_finest.relative, 0.3);
+  bool commit = false, sha = false, speed = false;
+  for (const auto& [k, v] : c.provenance) {
+    commit = commit || (k == "commit" && v == "abc1234");
+    sha = sha || (k == "soil_sha256" && v == std::string(64, 'a'));
+    speed = speed || (k == "conditions.cone_speed" && v == "0.4");
+  }
+  EXPECT_TRUE(commit && sha && speed);
+}
+
+// Nothing loads a table that does not say which particles it holds for, or where it came from.
+TEST(CiCalibration, RefusesATableWithoutParticleSizeProvenanceOrError) {
+  const std::string good = TableText(0.06, 0.1);
+  auto refused = [](const std::string& text, const std::vector<std::string>& words) {
+    ExpectWords(Refusal([&] { CiCalibration::Read(YamlReader::FromString(text, "table.yaml")); }),
+                std::vector<std::string>{"table.yaml"});
+    ExpectWords(Refusal([&] { CiCalibration::Read(YamlReader::FromString(text, "table.yaml")); }), words);
+  };
+  refused(Without(good, "particle_diameter:"), {"particle_diameter", "missing"});
+  std::string no_prov = good.substr(0, good.find("provenance:")) + good.substr(good.find("error_vs_finest:"));
+  refused(no_prov, {"provenance", "missing"});
+  refused(Without(good, "  soil_sha256:"), {"provenance.soil_sha256"});
+  refused(Without(good, "  commit:"), {"provenance.commit"});
+  std::string short_sha = good;
+  short_sha.replace(short_sha.find(std::string(64, 'a')), 64, "abc");
+  refused(short_sha, {"provenance.soil_sha256", "64 hex"});
+  refused(Without(good, "points:"), {"points", "missing"});
+  refused(Without(good, "error_vs_finest:"), {"error_vs_finest", "missing"});
+  refused(good + "particle_size: 0.06\n", {"unknown key", "particle_size"});
+  // an unknown error must say why
+  std::string unknown = good;
+  unknown.replace(unknown.find("{level: medium, relative: 0.3, note: measured}"), 46, "{level: coarse}");
+  refused(unknown, {"error_vs_finest.relative"});
+  // more seeds behind a point than the provenance lists
+  std::string seeds = good;
+  seeds.replace(seeds.find("seeds: [3, 3, 3]"), 16, "seeds: [3, 4, 3]");
+  refused(seeds, {"points.seeds", "provenance.seeds"});
+}
+
+// One file made for another particle size is refused, naming both sizes.
+TEST(CiCalibration, RefusesATableForAnotherParticleSize) {
+  TempDir dir;
+  const std::string file = dir.Write("cone_index_mu0.1_d0.05.yaml", TableText(0.05, 0.1));
+  EXPECT_DOUBLE_EQ(CiCalibration::LoadFor(file, 0.05, 0.1).particle_diameter, 0.05);
+  EXPECT_DOUBLE_EQ(CiCalibration::LoadFor(file, 0.05 * (1 + 1e-8), 0.1).particle_diameter, 0.05);
+  ExpectWords(Refusal([&] { CiCalibration::LoadFor(file, 0.06, 0.1); }),
+              {file, "particle_diameter", "0.05 m", "0.06 m"});
+  ExpectWords(Refusal([&] { CiCalibration::LoadFor(file, 0.05, 0.05); }), {file, "friction", "0.1", "0.05"});
+  ExpectWords(Refusal([&] { CiCalibration::LoadFor((dir.path / "none.yaml").string(), 0.05, 0.1); }),
+              {"none.yaml"});
+}
+
+// From a directory, the table of the particles and friction asked for; none or two is an error
+// that lists the tables there.
+TEST(CiCalibration, LoadForPicksTheTableOfTheParticlesFromADirectory) {
+  TempDir dir;
+  dir.Write("a.yaml", TableText(0.05, 0.1));
+  dir.Write("b.yaml", TableText(0.06, 0.1, "method: the one\n"));
+  dir.Write("c.yaml", TableText(0.06, 0.05));
+  dir.Write("notes.txt", "not a table");
+  const std::string d = dir.path.string();
+  const CiCalibration b = CiCalibration::LoadFor(d, 0.06, 0.1);
+  EXPECT_EQ(b.file, (dir.path / "b.yaml").string());
+  EXPECT_EQ(CiCalibration::LoadFor(d, 0.05, 0.1).file, (dir.path / "a.yaml").string());
+  EXPECT_EQ(CiCalibration::LoadFor(d, 0.06, 0.05).file, (dir.path / "c.yaml").string());
+  ExpectWords(Refusal([&] { CiCalibration::LoadFor(d, 0.04, 0.1); }),
+              {d, "particle_diameter", "0.04", "a.yaml (0.05 m, mu 0.1)", "b.yaml (0.06 m, mu 0.1)",
+               "c.yaml (0.06 m, mu 0.05)"});
+  dir.Write("d.yaml", TableText(0.06, 0.1));
+  ExpectWords(Refusal([&] { CiCalibration::LoadFor(d, 0.06, 0.1); }), {d, "b.yaml", "d.yaml", "one per"});
+  // a table in the directory without a particle size is an error, not skipped
+  dir.Write("d.yaml", Without(TableText(0.03, 0.1), "particle_diameter:"));
+  ExpectWords(Refusal([&] { CiCalibration::LoadFor(d, 0.06, 0.1); }), {"d.yaml", "particle_diameter"});
+}
+
+TEST(CiCalibration, DescribeWritesTheTableIntoAResult) {
+  const CiCalibration c = CiCalibration::Read(YamlReader::FromString(TableText(0.06, 0.1), "cal.yaml"));
+  ResultFile r("scene.yaml", "wheel");
+  c.Describe(&r);
+  const YAML::Node n = YAML::Load(r.Text());
+  EXPECT_EQ(n["calibration_table"].as<std::string>(), "cal.yaml");
+  EXPECT_EQ(n["calibration_level"].as<std::string>(), "coarse");
+  EXPECT_DOUBLE_EQ(n["calibration_particle_diameter"].as<double>(), 0.06);
+  EXPECT_DOUBLE_EQ(n["calibration_error_vs_finest"].as<double>(), 0.3);
+  EXPECT_EQ(n["calibration_finest_level"].as<std::string>(), "medium");
+  EXPECT_EQ(n["calibration_seeds"].as<int>(), 3);
+  // no finer level run: a text that says why, never NaN
+  std::string one = TableText(0.06, 0.1);
+  one.replace(one.find("{level: medium, relative: 0.3, note: measured}"), 46,
+              "{level: coarse, note: only this level was run}");
+  ResultFile r2("scene.yaml", "wheel");
+  CiCalibration::Read(YamlReader::FromString(one, "cal.yaml")).Describe(&r2);
+  const std::string e = YAML::Load(r2.Text())["calibration_error_vs_finest"].as<std::string>();
+  EXPECT_NE(e.find("only this level was run"), std::string::npos) << e;
+}
+
+// Every table installed in config/calibration says which particles it holds for, and one table
+// holds per particle size and friction.
+TEST(CiCalibration, InstalledTablesCarryTheirParticleSize) {
+  int tables = 0;
+  for (const auto& e : std::filesystem::directory_iterator(DM_CONFIG_DIR "/calibration")) {
+    if (e.path().extension() != ".yaml") continue;
+    ++tables;
+    const CiCalibration c = CiCalibration::Load(e.path().string());
+    EXPECT_GT(c.particle_diameter, 0.0) << c.file;
+    EXPECT_FALSE(c.provenance.empty()) << c.file;
+    EXPECT_EQ(CiCalibration::LoadFor(DM_CONFIG_DIR "/calibration", c.particle_diameter, c.friction).file,
+              CiCalibration::LoadFor(c.file, c.particle_diameter, c.friction).file);
+  }
+  EXPECT_GT(tables, 0);
 }
 
 TEST(DemShapes, ContainerFacetsAndConeMatchTheirGeometry) {
@@ -111,7 +310,7 @@ TEST(ConePenetrometer, PidHoldsTheConeSpeedInTheSoil) {
 // The cone index rises with f, and each run lies within the band the calibration table
 // (config/calibration/, from the coarse sweep) predicts for its f.
 TEST(ConePenetrometer, ConeIndexRisesWithFWithinTheCalibrationBand) {
-  const CiCalibration cal = CiCalibration::Load(DM_CONFIG_DIR "/calibration/cone_index_mu0.1.yaml");
+  const CiCalibration cal = CiCalibration::LoadFor(DM_CONFIG_DIR "/calibration", 0.06, 0.1);
   ASSERT_EQ(cal.level, "coarse");
   const double fs[2] = {0.3, 5.0};
   ConeResult r[2];

@@ -1,9 +1,12 @@
 """scripts/calibrate_cone_index.py without ROS: stand-in `roslaunch` and `rospack` commands on PATH
 write the result files a cone run would; the sweep's lines, files and exit status are those the
-end-to-end test (test/ros/test_cone_sweep.py) checks, and --resume keeps the good runs.
+end-to-end test (test/ros/test_cone_sweep.py) checks, --resume keeps the good runs, and with several
+seeds the table holds each f's mean and scatter over the seeds, the particle diameter of the level
+and its provenance.
 
     python3 -m unittest discover -s test/python -v      (from the repository root)
 """
+import hashlib
 import os
 import shutil
 import stat
@@ -26,10 +29,10 @@ except ImportError:
 ROSLAUNCH = r'''#!%s
 import os, sys, time, yaml
 args = dict(a.split(':=', 1) for a in sys.argv[1:] if ':=' in a)
-f, mu, bag = float(args['f']), float(args['mu']), args['bag']
+f, mu, seed, bag = float(args['f']), float(args['mu']), int(args['seed']), args['bag']
 assert sys.argv[1] == '-p' and os.environ['ROS_MASTER_URI'].endswith(':' + sys.argv[2])
 with open(os.path.join(os.path.dirname(bag), 'calls'), 'a') as fh:
-    fh.write('%%g %%g %%s\n' %% (f, mu, sys.argv[2]))
+    fh.write('%%g %%g %%s %%d\n' %% (f, mu, sys.argv[2], seed))
 print('[ INFO] terrain: progress: t = 0.1 s', flush=True)
 time.sleep(0.2)
 res = bag[:-4] + '.result.yaml'
@@ -37,10 +40,10 @@ if f > 15:
     with open(res, 'w') as fh:
         yaml.safe_dump({'status': 'error', 'error': 'parameter cohesion_factor: %%g is out of range' %% f}, fh)
     sys.exit(1)
-ci = 30 + 20 * f
+ci = 30 + 20 * f + 2 * (seed - 1)   # seeds 1, 2, 3: mean 30 + 20 f + 2, sample std 2
 open(bag, 'w').write('bag')
 with open(res, 'w') as fh:
-    yaml.safe_dump({'fidelity': args['fidelity'], 'cohesion_factor': f, 'friction': mu, 'cone_index_psi': ci,
+    yaml.safe_dump({'fidelity': args['fidelity'], 'cohesion_factor': f, 'friction': mu, 'seed': seed, 'cone_index_psi': ci,
                     'window_samples': 4, 'wall_time': 1.5, 'error': '',
                     'history': {'t': [0.0, 0.5, 1.0], 'ci_psi': [0.0, ci / 2, ci]}}, fh)
 ''' % sys.executable
@@ -65,43 +68,58 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
             cls.first_summary = yaml.safe_load(fh)
         os.remove(os.path.join(cls.out, 'runs', 'calls'))
         cls.second = cls.sweep('0.5,8,20,3', '--resume')
+        # three seeds per f, against a finest level's runs, installed into a directory
+        cls.seeds_out = os.path.join(cls.tmp, 'seeds')
+        cls.install = os.path.join(cls.tmp, 'installed')
+        os.makedirs(cls.install)
+        cls.finest = os.path.join(cls.tmp, 'finest.yaml')
+        with open(cls.finest, 'w') as fh:
+            # the stand-in's CI is 30 + 20 f + 2 (mean over the seeds): the finest level reads 10 % below at f = 1
+            yaml.safe_dump({'level': 'medium', 'friction': 0.1, 'particle_diameter': 0.05, 'source': 'a test',
+                            'points': {'f': [1.0], 'ci': [52.0 / 1.1]}}, fh)
+        cls.seeded = cls.sweep('0.5,1,3', '--seeds', '1,2,3', '--jobs', '1', '--finest', cls.finest,
+                               '--install', cls.install, out=cls.seeds_out)
+        with open(os.path.join(ROOT, 'config', 'scenes', 'cone_penetrometer.yaml')) as fh:
+            cls.tiny = yaml.safe_load(fh)['levels']['tiny']
 
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, True)
 
     @classmethod
-    def sweep(cls, f, *more):
+    def sweep(cls, f, *more, out=None):
         return subprocess.run(
             [sys.executable, os.path.join(ROOT, 'scripts', 'calibrate_cone_index.py'), '--fidelity', 'tiny',
-             '--f', f, '--mu', '0.1', '--jobs', '2', '--cloud-rate', '10', '--port', '11711', '--out', cls.out]
+             '--f', f, '--mu', '0.1', '--jobs', '2', '--cloud-rate', '10', '--port', '11711', '--out', out or cls.out]
             + list(more), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
             env=cls.env, timeout=300)
 
     def test_failed_run_reported_rest_kept(self):
         self.assertEqual(self.first.returncode, 1, self.first.stdout)
         self.assertIn('FAILED', self.first.stdout)
-        self.assertIn('sweep: 3 runs (f 0.5,8,20 x mu 0.1), level tiny, 2 at a time\n', self.first.stdout)
-        self.assertRegex(self.first.stdout, r'\[ +\d+ s\] done   mu0.1_f8       CI 190.0 psi \(\d+ s\)  \[\d/3\]')
-        self.assertIn('  failed: mu0.1_f20: parameter cohesion_factor: 20 is out of range', self.first.stdout)
+        self.assertIn('sweep: 3 runs (f 0.5,8,20 x mu 0.1 x seeds 1), level tiny, 2 at a time\n', self.first.stdout)
+        self.assertRegex(self.first.stdout, r'\[ +\d+ s\] done   mu0.1_f8_s1    CI 190.0 psi \(\d+ s\)  \[\d/3\]')
+        self.assertIn('  failed: mu0.1_f20_s1: parameter cohesion_factor: 20 is out of range', self.first.stdout)
         sweep = self.first_summary
-        self.assertEqual(list(sweep), ['fidelity', 'wall_time', 'jobs', 'runs'])
-        self.assertEqual((sweep['fidelity'], sweep['jobs']), ('tiny', 2))
+        self.assertEqual(list(sweep), ['fidelity', 'wall_time', 'jobs', 'seeds', 'runs'])
+        self.assertEqual((sweep['fidelity'], sweep['jobs'], sweep['seeds']), ('tiny', 2, [1]))
         runs = {r['f']: r for r in sweep['runs']}
-        self.assertEqual(list(runs[0.5]), ['f', 'mu', 'ok', 'cone_index_psi', 'wall_time', 'error', 'bag'])
+        self.assertEqual(list(runs[0.5]), ['f', 'mu', 'seed', 'ok', 'cone_index_psi', 'wall_time', 'error', 'bag'])
         self.assertFalse(runs[20.0]['ok'])
         self.assertIsNone(runs[20.0]['cone_index_psi'])
         self.assertIn('cohesion_factor', runs[20.0]['error'])
         self.assertTrue(runs[0.5]['ok'] and runs[8.0]['ok'])
         self.assertGreater(runs[8.0]['cone_index_psi'], runs[0.5]['cone_index_psi'])
-        self.assertEqual(runs[0.5]['bag'], os.path.join(self.out, 'runs', 'mu0.1_f0.5.bag'))
+        self.assertEqual(runs[0.5]['bag'], os.path.join(self.out, 'runs', 'mu0.1_f0.5_s1.bag'))
 
     def test_table_and_plots(self):
-        with open(os.path.join(self.out, 'cone_index_mu0.1.yaml')) as fh:
+        with open(os.path.join(self.out, 'cone_index_mu0.1_d%g.yaml' % self.tiny['particle_diameter'])) as fh:
             cal = yaml.safe_load(fh)
         self.assertEqual(cal['fidelity'], 'tiny')
         self.assertEqual(len(cal['cubic']), 4)
-        self.assertEqual(cal['runs'], [[0.5, 40.0], [3.0, 90.0], [8.0, 190.0]])
+        self.assertEqual(cal['runs'], {'f': [0.5, 3.0, 8.0], 'seed': [1, 1, 1], 'ci': [40.0, 90.0, 190.0]})
+        # one seed per f: the points hold the runs and no scatter
+        self.assertEqual(cal['points'], {'f': [0.5, 3.0, 8.0], 'ci_mean': [40.0, 90.0, 190.0], 'seeds': [1, 1, 1]})
         for name in ('ci_vs_time_mu0.1.png', 'ci_vs_f.png'):
             with open(os.path.join(self.out, name), 'rb') as fh:
                 self.assertEqual(fh.read(8), b'\x89PNG\r\n\x1a\n', name)
@@ -109,8 +127,8 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
     def test_resume_keeps_good_runs(self):
         out = self.second.stdout
         self.assertEqual(self.second.returncode, 1, out)
-        self.assertIn('kept   mu0.1_f0.5     CI 40.0 psi (from %s)' % os.path.join(self.out, 'runs', 'mu0.1_f0.5.result.yaml'), out)
-        self.assertIn('kept   mu0.1_f8       CI 190.0 psi', out)
+        self.assertIn('kept   mu0.1_f0.5_s1  CI 40.0 psi (from %s)' % os.path.join(self.out, 'runs', 'mu0.1_f0.5_s1.result.yaml'), out)
+        self.assertIn('kept   mu0.1_f8_s1    CI 190.0 psi', out)
         with open(os.path.join(self.out, 'runs', 'calls')) as fh:
             calls = [line.split() for line in fh]
         self.assertEqual(sorted(c[0] for c in calls), ['20', '3'])
@@ -121,6 +139,60 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         self.assertEqual(runs[0.5]['wall_time'], 1.5)  # a kept run's own wall time
         self.assertTrue(runs[3.0]['ok'])
         self.assertFalse(runs[20.0]['ok'])
+
+    def test_seeds_give_each_point_its_mean_and_scatter(self):
+        self.assertEqual(self.seeded.returncode, 0, self.seeded.stdout)
+        self.assertIn('x seeds 1,2,3), level tiny, 1 at a time', self.seeded.stdout)
+        with open(os.path.join(self.seeds_out, 'runs', 'calls')) as fh:
+            calls = sorted((float(c[0]), int(c[3])) for c in (line.split() for line in fh))
+        self.assertEqual(calls, [(f, s) for f in (0.5, 1.0, 3.0) for s in (1, 2, 3)])
+        name = 'cone_index_mu0.1_d%g.yaml' % self.tiny['particle_diameter']
+        with open(os.path.join(self.seeds_out, name)) as fh:
+            cal = yaml.safe_load(fh)
+        self.assertEqual(cal['particle_diameter'], self.tiny['particle_diameter'])
+        self.assertEqual(cal['friction'], 0.1)
+        pts = cal['points']
+        self.assertEqual(pts['f'], [0.5, 1.0, 3.0])
+        self.assertEqual(pts['seeds'], [3, 3, 3])
+        for f, mean, sd in zip(pts['f'], pts['ci_mean'], pts['ci_std']):
+            self.assertAlmostEqual(mean, 30 + 20 * f + 2, places=3)  # the stand-in's CI, averaged over the seeds
+            self.assertAlmostEqual(sd, 2.0, places=3)                # its sample std over the seeds
+        self.assertEqual(sorted(zip(cal['runs']['f'], cal['runs']['seed'])),
+                         [(f, s) for f in (0.5, 1.0, 3.0) for s in (1, 2, 3)])
+        # the table is fitted to the means: it passes through them at the ends
+        self.assertAlmostEqual(cal['table'][0][0], round(pts['ci_mean'][0], 1), places=6)
+        self.assertAlmostEqual(cal['table'][-1][0], round(pts['ci_mean'][-1], 1), places=6)
+
+    def test_provenance(self):
+        name = 'cone_index_mu0.1_d%g.yaml' % self.tiny['particle_diameter']
+        with open(os.path.join(self.seeds_out, name)) as fh:
+            prov = yaml.safe_load(fh)['provenance']
+        head = subprocess.run(['git', '-C', ROOT, 'rev-parse', 'HEAD'], stdout=subprocess.PIPE,
+                              universal_newlines=True).stdout.strip()
+        self.assertTrue(prov['commit'].startswith(head), prov['commit'])
+        self.assertEqual(prov['seeds'], [1, 2, 3])
+        self.assertEqual(prov['soil_file'], 'config/soils/nominal_clay.yaml')
+        with open(os.path.join(ROOT, 'config', 'soils', 'nominal_clay.yaml'), 'rb') as fh:
+            self.assertEqual(prov['soil_sha256'], hashlib.sha256(fh.read()).hexdigest())
+        self.assertEqual(prov['scene_file'], 'config/scenes/cone_penetrometer.yaml')
+        self.assertRegex(str(prov['date']), r'^\d{4}-\d\d-\d\d$')
+        for key in ('container_diameter', 'soil_depth', 'cone_speed', 'ci_window'):
+            self.assertEqual(prov['conditions'][key], self.tiny[key], key)
+
+    def test_error_vs_finest_and_install(self):
+        name = 'cone_index_mu0.1_d%g.yaml' % self.tiny['particle_diameter']
+        with open(os.path.join(self.install, name)) as fh:
+            cal = yaml.safe_load(fh)   # --install DIR: the table under its own name
+        err = cal['error_vs_finest']
+        self.assertEqual(err['level'], 'medium')
+        self.assertAlmostEqual(err['relative'], 0.1, places=2)
+        self.assertIn('finest.yaml', err['note'])
+        # without --finest the file says that only its own level was run, and gives no number
+        with open(os.path.join(self.out, name)) as fh:
+            err = yaml.safe_load(fh)['error_vs_finest']
+        self.assertEqual(err['level'], 'tiny')
+        self.assertNotIn('relative', err)
+        self.assertIn('only this level', err['note'])
 
 
 if __name__ == '__main__':

@@ -40,9 +40,13 @@ class ConeSweep(unittest.TestCase):
         self.assertGreater(runs[8.0]['cone_index_psi'], runs[0.5]['cone_index_psi'])
 
     def test_table_and_fit(self):
-        with open(os.path.join(self.out, 'cone_index_mu0.1.yaml')) as fh:
+        with open(os.path.join(ROOT, 'config', 'scenes', 'cone_penetrometer.yaml')) as fh:
+            d = yaml.safe_load(fh)['levels']['tiny']['particle_diameter']
+        with open(os.path.join(self.out, 'cone_index_mu0.1_d%g.yaml' % d)) as fh:
             cal = yaml.safe_load(fh)
         self.assertEqual(cal['fidelity'], 'tiny')
+        self.assertEqual(cal['particle_diameter'], d)
+        self.assertEqual(cal['provenance']['seeds'], [1])
         self.assertEqual(len(cal['cubic']), 4)
         rows = cal['table']
         self.assertGreaterEqual(len(rows), 2)
@@ -50,7 +54,7 @@ class ConeSweep(unittest.TestCase):
             self.assertLess(a[0], b[0])
             self.assertLess(a[1], b[1])
         # the table passes through the two runs (a line through two points)
-        for f, ci in cal['runs']:
+        for f, ci in zip(cal['runs']['f'], cal['runs']['ci']):
             self.assertTrue(any(abs(r[0] - round(ci, 1)) < 0.06 and abs(r[1] - f) < 0.01 * f for r in rows),
                             (f, ci, rows))
 
@@ -60,7 +64,7 @@ class ConeSweep(unittest.TestCase):
                 self.assertEqual(fh.read(8), b'\x89PNG\r\n\x1a\n', name)
 
     def test_bag_holds_particles_ci_history_and_result(self):
-        bag_path = os.path.join(self.out, 'runs', 'mu0.1_f0.5.bag')
+        bag_path = os.path.join(self.out, 'runs', 'mu0.1_f0.5_s1.bag')
         with open(bag_path[:-4] + '.result.yaml') as fh:
             res = yaml.safe_load(fh)
         counts, result, clouds = {}, None, 0

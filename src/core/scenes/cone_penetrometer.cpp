@@ -25,6 +25,10 @@ ConeLevel ReadLevel(const YamlReader& y, const std::string& name) {
   l.container_diameter = y.DoubleIn("container_diameter", 0.1, 20.0);
   l.soil_depth = y.DoubleIn("soil_depth", 0.05, 20.0);
   l.cone_speed = y.DoubleIn("cone_speed", 1e-3, 5.0);
+  if (y.Has("approach_depth") || y.Has("approach_speed")) {
+    l.approach_depth = y.DoubleIn("approach_depth", 0.0, 20.0);
+    l.approach_speed = y.DoubleIn("approach_speed", 1e-3, 5.0);
+  }
   l.time_step = y.DoubleIn("time_step", 1e-8, 1e-3);
   l.settle_time = y.DoubleIn("settle_time", 0.0, 100.0);
   l.hold_time = y.DoubleIn("hold_time", 0.0, 100.0);
@@ -58,13 +62,16 @@ ConeParams ConeParams::Read(const YamlReader& y) {
   }
   if (!found) y.Fail("fidelity", "no level '" + fidelity + "' under levels: (" + names + ")");
   // the soil: f directly, or from a requested cone index through a calibration table
+  // (through the table of the level's particle size and the friction: CI(f) depends on both)
   const double f_file = y.Has("cohesion_factor") ? y.Double("cohesion_factor") : 1.0;
+  p.friction = y.DoubleIn("friction", 0.0, 2.0);
   if (y.Has("calibration")) p.calibration_file = y.ResolvePath(y.String("calibration"));
   if (y.Has("cone_index")) {
     p.requested_ci = y.Positive("cone_index");
     if (p.calibration_file.empty()) y.Fail("calibration", "is needed to turn cone_index into f");
     try {
-      p.cohesion_factor = CiCalibration::Load(p.calibration_file).CohesionFactor(p.requested_ci);
+      p.calibration = CiCalibration::LoadFor(p.calibration_file, p.level.particle_diameter, p.friction);
+      p.cohesion_factor = p.calibration->CohesionFactor(p.requested_ci);
     } catch (const ConfigError& e) {
       y.Fail("cone_index", e.what());
     }
@@ -76,7 +83,6 @@ ConeParams ConeParams::Read(const YamlReader& y) {
     y.Fail(y.Has("cone_index") ? "cone_index" : "cohesion_factor",
            "the cohesion factor f = " + detail::Concat(p.cohesion_factor) + " lies outside the paper's range [" +
                detail::Concat(kMinCohesionFactor) + ", " + detail::Concat(kMaxCohesionFactor) + "]");
-  p.friction = y.DoubleIn("friction", 0.0, 2.0);
   p.soil.diameter = p.level.particle_diameter;
   p.soil.cohesion_factor = p.cohesion_factor;
   p.soil.friction = p.friction;
@@ -128,6 +134,9 @@ ConeParams ConeParams::Read(const YamlReader& y) {
     y.Fail(where + ".ci_window", "ends at a tip depth of " + detail::Concat(l.ci_to) + " m, too deep for soil poured " +
                                      detail::Concat(l.soil_depth) + " m deep (it settles to about " +
                                      detail::Concat(0.7 * l.soil_depth) + " m)");
+  if (l.approach_speed > 0.0 && !(l.approach_depth < l.ci_from))
+    y.Fail(where + ".approach_depth", "must end above the CI window (" + detail::Concat(l.ci_from) +
+                                         " m): the window is penetrated at cone_speed");
   if (l.ci_from < p.cone_length)
     y.Fail(where + ".ci_window", "starts at a tip depth of " + detail::Concat(l.ci_from) +
                                      " m, before the cone's base (" + detail::Concat(p.cone_length) +
@@ -204,9 +213,24 @@ double ConePenetrometer::penetration_force() const {
   return dem_->wall(cone_).force.z() + dem_->wall(rod_).force.z();
 }
 
+void ConePenetrometer::Reference(double t, double* z, double* v) const {
+  const ConeLevel& l = p_.level;
+  const double s = t - t0_;
+  // at approach_speed over the start gap and down to approach_depth, then at cone_speed
+  const double d1 = l.approach_speed > 0.0 ? p_.start_gap + l.approach_depth : 0.0;
+  const double t1 = l.approach_speed > 0.0 ? d1 / l.approach_speed : 0.0;
+  if (s < t1) {
+    *z = z0_ - l.approach_speed * s;
+    *v = -l.approach_speed;
+  } else {
+    *z = z0_ - d1 - l.cone_speed * (s - t1);
+    *v = -l.cone_speed;
+  }
+}
+
 void ConePenetrometer::PlaceCone() {
   z_tip_ = z0_ = surface_ + p_.start_gap;
-  v_tip_ = -p_.level.cone_speed;
+  v_tip_ = p_.level.approach_speed > 0.0 ? -p_.level.approach_speed : -p_.level.cone_speed;
   t0_ = dem_->time();
   // the integral starts at the weight, so the cone does not sag when it is let go
   integral_ = p_.ki > 0.0 ? p_.cone_mass * 9.81 / p_.ki : 0.0;
@@ -217,7 +241,8 @@ void ConePenetrometer::PlaceCone() {
 void ConePenetrometer::StepCone() {
   // PID on the prescribed tip height, the soil's force from the last evaluation, semi-implicit Euler
   const double dt = p_.level.time_step, t = dem_->time() + dt;
-  const double z_ref = z0_ - p_.level.cone_speed * (t - t0_), v_ref = -p_.level.cone_speed;
+  double z_ref = 0.0, v_ref = 0.0;
+  Reference(t, &z_ref, &v_ref);
   const double e = z_ref - z_tip_, de = v_ref - v_tip_;
   integral_ += e * dt;
   const double actuator = p_.kp * e + p_.ki * integral_ + p_.kd * de;
@@ -259,7 +284,7 @@ void ConePenetrometer::StartPenetration() {
   PlaceCone();
   StepCone();  // cone walls to their start (a jump: the next step rebuilds the lists)
   z_tip_ = z0_;
-  v_tip_ = -p_.level.cone_speed;
+  v_tip_ = p_.level.approach_speed > 0.0 ? -p_.level.approach_speed : -p_.level.cone_speed;
   phase_ = Phase::kPenetrate;
 }
 
@@ -306,8 +331,10 @@ ConeResult ConePenetrometer::Result() const {
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
   r.speed_min = 1e30;
   r.speed_max = -1e30;
+  // the speed once the tip is in the soil (and past the approach, if any)
+  const double speed_from = std::max(d, p_.level.approach_speed > 0.0 ? p_.level.approach_depth + d : 0.0);
   for (const ConeSample& c : samples_) {
-    if (c.depth >= d) {
+    if (c.depth >= speed_from) {
       r.speed_min = std::min(r.speed_min, c.speed);
       r.speed_max = std::max(r.speed_max, c.speed);
     }
@@ -343,10 +370,8 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
   f.Set("fidelity", r.level);
   f.Set("cohesion_factor", r.cohesion_factor);
   f.Set("friction", r.friction);
-  if (std::isfinite(r.requested_ci)) {
-    f.Set("requested_cone_index_psi", r.requested_ci);
-    f.Set("calibration", p.calibration_file);
-  }
+  if (std::isfinite(r.requested_ci)) f.Set("requested_cone_index_psi", r.requested_ci);
+  if (p.calibration) p.calibration->Describe(&f);  // which table f came from, and its error
   f.Set("cone_index_psi", r.ci_psi);
   f.Set("cone_index_std_psi", r.ci_std_psi);
   f.Set("cone_index_trend_psi_per_m", r.ci_trend_psi_per_m);
@@ -357,6 +382,13 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
   f.Set("particles", r.particles);
   f.Set("particle_diameter", p.level.particle_diameter);
   f.Set("container_diameter", p.level.container_diameter);
+  f.Set("soil_depth", p.level.soil_depth);
+  f.Set("cone_speed", p.level.cone_speed);
+  if (p.level.approach_speed > 0.0) {
+    f.Set("approach_speed", p.level.approach_speed);
+    f.Set("approach_depth", p.level.approach_depth);
+  }
+  f.Set("seed", p.seed);
   f.Set("surface_height", r.surface_height);
   f.Set("bulk_density_poured", r.density_poured);
   f.Set("bulk_density_consolidated", r.density_consolidated);

@@ -14,6 +14,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,10 @@ struct ConeLevel {
   double particle_diameter = 0.03;   ///< [m] (overrides the soil file's)
   double container_diameter = 2.0;   ///< [m]
   double soil_depth = 1.5;           ///< poured depth the particle count is chosen for [m]
-  double cone_speed = 0.1;           ///< [m/s]
+  double cone_speed = 0.1;           ///< [m/s] through the CI window
+  /// An optional faster approach: the cone descends at approach_speed until its tip is
+  /// approach_depth below the surface (above the window), then at cone_speed. 0: no approach.
+  double approach_speed = 0.0, approach_depth = 0.0;
   double time_step = 1.5e-5;         ///< [s]
   double settle_time = 0.6;          ///< [s] after the pour
   double hold_time = 0.5;            ///< [s] at the lid pressure
@@ -48,7 +52,8 @@ struct ConeParams {
   double cohesion_factor = 1.0;    ///< f
   double friction = 0.1;           ///< inter-particle mu
   double requested_ci = std::numeric_limits<double>::quiet_NaN();  ///< when f came from a calibration
-  std::string calibration_file;
+  std::string calibration_file;    ///< `calibration`: a table or a directory of tables
+  std::optional<CiCalibration> calibration;  ///< the table f came from (for the level's particles and mu)
   int container_segments = 24;
   double solid_fraction = 0.58;    ///< poured solid fraction assumed for the particle count
   // the penetrometer (table 1)
@@ -91,7 +96,7 @@ struct ConeResult {
   double ci_psi = 0.0;               ///< mean over the window: the cone index
   double ci_std_psi = 0.0;           ///< scatter of the samples in the window
   double ci_trend_psi_per_m = 0.0;   ///< slope of CI over tip depth in the window
-  double speed_min = 0.0, speed_max = 0.0;  ///< of the samples in the soil (tip below one diameter)
+  double speed_min = 0.0, speed_max = 0.0;  ///< of the samples in the soil (tip below one diameter and past the approach)
   int window_samples = 0;
   std::vector<ConeSample> samples;
   double prep_time = 0.0;            ///< simulated time of the preparation [s]
@@ -139,6 +144,8 @@ class ConePenetrometer final : public SoilRig {
  private:
   enum class Phase { kPrepare, kPenetrate, kDone };
   void PlaceCone();
+  /// The prescribed tip height and velocity at time t (the approach, then cone_speed).
+  void Reference(double t, double* z, double* v) const;
   void StepCone();
   void StartPenetration();
   void Sample();
