@@ -111,6 +111,7 @@ SingleWheelRig::SingleWheelRig(const SingleWheelRig& o)
       sunk_(o.sunk_),
       s_dp_(o.s_dp_), s_torque_(o.s_torque_), s_fz_(o.s_fz_), s_sink_(o.s_sink_), s_omega_(o.s_omega_),
       s_t0_(o.s_t0_), s_x0_(o.s_x0_), s_n_(o.s_n_),
+      rest_fz_(o.rest_fz_), rest_sink_(o.rest_sink_), rest_n_(o.rest_n_),
       samples_(o.samples_),
       wall0_(o.wall0_),
       prep_wall_time_(o.prep_wall_time_),
@@ -221,6 +222,11 @@ void SingleWheelRig::Step() {
     sunk_ = true;
     phase_ = Phase::kDone;
     return;
+  }
+  if (phase_ == Phase::kSettle && t_phase_ >= 0.5 * p_.settle_time) {
+    rest_fz_ += bin_->Wrench(0).force.z();
+    rest_sink_ += sinkage();
+    ++rest_n_;
   }
   if (phase_ == Phase::kLoad && t_phase_ >= p_.load_time - 0.5 * p_.bin.level.time_step) {
     phase_ = Phase::kSettle;
@@ -345,6 +351,9 @@ ResultFile SingleWheelResultFile(const SingleWheelRig& rig) {
   f.Set("slip", w.slip);
   f.Set("wheel_speed", w.omega);
   f.Set("vertical_force", w.vertical_force);
+  f.Set("rest_vertical_force", rig.rest_vertical_force());
+  f.Set("rest_load_ratio", rig.rest_vertical_force() / W);
+  f.Set("rest_sinkage", rig.rest_sinkage());
   f.Set("particles", s.num_alive());
   f.Set("surface_height", bin.surface_height());
   const SoilBinLevel& l = p.bin.level;

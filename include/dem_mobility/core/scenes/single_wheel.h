@@ -36,9 +36,9 @@ struct SingleWheelParams {
   double load_mass = 1230.0;    ///< [kg] carriage and wheel: the vertical load is its weight
   double speed = 1.0;           ///< carriage speed [m/s]
   double wheel_inertia = 6.0;   ///< about the axle [kg m^2] (towed and torque drives)
-  double carriage_damping = 2.0e4;  ///< vertical damper of the carriage [N s/m]
+  double carriage_damping = 5.0e3;  ///< vertical damper of the carriage [N s/m]
   double load_time = 0.3;       ///< [s] the load ramps up
-  double settle_time = 0.2;     ///< [s] at rest under the full load
+  double settle_time = 0.6;     ///< [s] at rest under the full load
   double accel_time = 0.2;      ///< [s] the carriage ramps up to its speed
   double start_x = 0.0;         ///< wheel centre at the start, from the bin's start [m]
   double window_from = 1.0, window_to = 2.0;  ///< carriage travel of the measuring window [m]
@@ -112,6 +112,10 @@ class SingleWheelRig final : public SoilRig {
     double slip = 0.0, omega = 0.0, vertical_force = 0.0;
   };
   Window Measured() const;
+  /// At rest under the full load (the last half of the settle phase): the soil's mean vertical
+  /// force on the wheel and the mean sinkage.
+  double rest_vertical_force() const { return rest_n_ > 0 ? rest_fz_ / rest_n_ : 0.0; }
+  double rest_sinkage() const { return rest_n_ > 0 ? rest_sink_ / rest_n_ : 0.0; }
 
  private:
   enum class Phase { kPrepare, kLoad, kSettle, kDrive, kDone };
@@ -129,6 +133,8 @@ class SingleWheelRig final : public SoilRig {
   // the current sample's sums
   double s_dp_ = 0.0, s_torque_ = 0.0, s_fz_ = 0.0, s_sink_ = 0.0, s_omega_ = 0.0, s_t0_ = 0.0, s_x0_ = 0.0;
   long s_n_ = 0;
+  double rest_fz_ = 0.0, rest_sink_ = 0.0;
+  long rest_n_ = 0;
   std::vector<WheelSample> samples_;
   std::chrono::steady_clock::time_point wall0_;
   double prep_wall_time_ = 0.0;
