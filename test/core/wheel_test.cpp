@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_mobility/core/geometry/tire_geometry.h"
@@ -256,6 +257,26 @@ TEST(SingleWheelConfig, RefusesBadInputNamingTheKey) {
   // slips at the ends of the range that make sense are taken
   EXPECT_NO_THROW(SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"wheel.slip=-1"})));
   EXPECT_NO_THROW(SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"wheel.slip=0.99"})));
+}
+
+TEST(SingleWheelConfig, UsesTheCalibrationTableOfItsParticleSizeOnly) {
+  // coarse (0.06 m): the table made at 0.06 m turns CI into f and is named in the result
+  const SingleWheelParams coarse =
+      SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"fidelity=coarse", "cone_index=100"}));
+  ASSERT_TRUE(coarse.bin.calibration);
+  EXPECT_DOUBLE_EQ(coarse.bin.calibration->particle_diameter, 0.06);
+  EXPECT_DOUBLE_EQ(coarse.bin.cohesion_factor, coarse.bin.calibration->CohesionFactor(100.0));
+  ResultFile r(SceneFile(), "single_wheel");
+  coarse.bin.Describe(&r);
+  EXPECT_NE(r.Text().find("calibration_table"), std::string::npos);
+  EXPECT_NE(r.Text().find("calibration_error_vs_finest"), std::string::npos);
+  // tiny (0.1 m): no table is made at that size; a cone index is refused, f runs with its CI unknown
+  ExpectRefused({"fidelity=tiny", "cone_index=100"}, "particle_diameter");
+  const SingleWheelParams tiny =
+      SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"fidelity=tiny", "cohesion_factor=2"}));
+  EXPECT_FALSE(tiny.bin.calibration);
+  EXPECT_FALSE(std::isfinite(tiny.bin.ConeIndex()));
+  EXPECT_NE(tiny.bin.no_table_reason.find("0.1"), std::string::npos) << tiny.bin.no_table_reason;
 }
 
 TEST(SingleWheelRig, ALoadTheSoilCannotCarryIsReportedSunk) {

@@ -72,12 +72,13 @@ DemSoilParams DemSoilParams::Read(const YamlReader& y) {
     if (!y.Has("cohesion_factor")) y.Fail("cohesion_factor", "is not set (nor is cone_index)");
     p.cohesion_factor = y.Double("cohesion_factor");
     if (!p.calibration_file.empty()) {
-      // the table only names the CI this f stands for; a table for another size is refused
+      // a table at this particle size only names the CI this f stands for; without one the CI
+      // is unknown (and the result says why)
       try {
         p.calibration = std::make_shared<CiCalibration>(
             CiCalibration::LoadFor(p.calibration_file, p.level.particle_diameter, p.friction));
       } catch (const ConfigError& e) {
-        y.Fail("calibration", e.what());
+        p.no_table_reason = e.what();
       }
     }
   }
@@ -142,7 +143,8 @@ void DemSoilParams::Describe(ResultFile* r) const {
   if (std::isfinite(ci))
     r->Set("cone_index_psi", ci);
   else
-    r->Set("cone_index_psi", std::string("unknown: f given directly and no calibration table at this particle size"));
+    r->Set("cone_index_psi", std::string("unknown: f given directly and no calibration table names its CI") +
+                                 (no_table_reason.empty() ? std::string() : " (" + no_table_reason + ")"));
   if (calibration) calibration->Describe(r);
 }
 

@@ -45,7 +45,8 @@ struct DemSoilParams {
   double friction = 0.1;            ///< inter-particle mu
   double requested_ci = std::numeric_limits<double>::quiet_NaN();  ///< [psi] when f came from the table
   std::string calibration_file;
-  std::shared_ptr<CiCalibration> calibration;  ///< the table used (when cone_index was given)
+  std::shared_ptr<CiCalibration> calibration;  ///< the table used or naming f's CI (none: no table at this size)
+  std::string no_table_reason;      ///< why no table names f's CI
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< the bin's (x = 0, y = 0, z = 0) in the scene
   double consolidation = 0.7;       ///< consolidated / poured depth, to choose the particle count
   double solid_fraction = 0.58;     ///< of the poured soil
