@@ -356,7 +356,7 @@ def summarise(outcomes, soil_key, soils, opts):
 def write_summary(path, doc):
     with open(path, 'w') as fh:
         fh.write('# Single-wheel slip sweep: written by scripts/single_wheel_sweep.py. DP/W and T/(W r) against\n'
-                 '# slip per soil beside the empirical references (see `reference`); docs/single-wheel-sweep.md.\n')
+                 '# slip per soil beside the empirical references (see `reference`); docs/single-wheel.md.\n')
         yaml.safe_dump(doc, fh, sort_keys=False, default_flow_style=None, width=120)
     return path
 
