@@ -58,9 +58,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   for (int i = 3; i < argc; ++i) overrides.push_back(argv[i]);
   const SingleWheelParams p = SingleWheelParams::Read(YamlReader::LoadWithOverrides(argv[1], overrides));
-  // the rig to steady rolling (0.3 m past the window's start), at 2 threads
+  // the rig to steady rolling (0.3 m of travel), at the scene's threads
   SingleWheelRig rig(p);
-  rig.set_threads(2);
   const auto t0 = std::chrono::steady_clock::now();
   while (!rig.done() && !(rig.driving() && rig.travel() >= 0.3)) rig.Step();
   if (rig.done()) {

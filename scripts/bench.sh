@@ -85,5 +85,5 @@ fi
 if [ "$want" = all ] || [ "$want" = wheel_soil ]; then
   # the coarse rig (6 cm particles, 4 x 1 m bin, f 1.5) rolling at 20 % slip, 2000 timed steps
   "$DM_BUILD/core/bench/wheel_soil_bench" "$DM_ROOT/config/scenes/single_wheel.yaml" 2000 fidelity=coarse \
-    cohesion_factor=1.5 wheel.drive=slip wheel.slip=0.2
+    cohesion_factor=1.5 wheel.drive=slip wheel.slip=0.2 threads=1
 fi

@@ -81,6 +81,7 @@ RollResult Roll(bool bins, int steps) {
   soil.diameter = 0.06;
   DemSettings st;
   st.wall_bins = bins;
+  st.max_overlap = 0.4;  // as the soil scenes: room for a particle dropped in against the tire
   DemSystem s(soil, st);
   const TireGeometry tire = PaperTire();
   DemWall w;
@@ -108,6 +109,9 @@ RollResult Roll(bool bins, int steps) {
     tw_.velocity = Vector3d(v, 0.0, -sink / (steps * dt));
     tw_.angular_velocity = Vector3d(0.0, omega, 0.0);
     tw_.wrench_point = tw_.position;
+    // now and then a particle dropped in just ahead of the tire: its first steps try the tire's
+    // triangles before any build lists it (the binned wall: its cell's)
+    if (n % 400 == 0) s.AddParticle(tw_.position + Vector3d(0.5, 0.03 * (n % 3), -0.1));  // touching it
     s.Step();
     r.force.push_back(s.wall(tw).force);
     r.moment.push_back(s.wall(tw).moment);
