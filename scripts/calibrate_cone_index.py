@@ -54,6 +54,15 @@ def ints(text):
         raise argparse.ArgumentTypeError('expected a comma-separated list of whole numbers, got %r' % text)
 
 
+def seeds_at(text):
+    """'12=1,3,4' -> (12.0, [1, 3, 4])."""
+    try:
+        f, seeds = text.split('=', 1)
+        return float(f), ints(seeds)
+    except ValueError:
+        raise argparse.ArgumentTypeError('expected F=SEED,SEED,..., got %r' % text)
+
+
 def case_name(mu, f, seed):
     return 'mu%g_f%g_s%d' % (mu, f, seed)
 
@@ -267,6 +276,9 @@ def main():
     ap.add_argument('--seeds', type=ints, default=ints('1'),
                     help='seeds of the poured lattice, each f and mu is run with every one (default 1; a table '
                          'point wants at least 3)')
+    ap.add_argument('--seeds-at', type=seeds_at, action='append', default=[], metavar='F=SEEDS',
+                    help='other seeds at one f (e.g. 12=1,3,4 when seed 2 fails there); may be repeated')
+    ap.add_argument('--note', help="a note for the table's provenance (e.g. where runs kept by --resume were made)")
     ap.add_argument('--finest', help="YAML of the finest level's runs (level, friction, particle_diameter, "
                                      "points: {f: [...], ci: [...]}, source) to give the table its error against")
     ap.add_argument('--jobs', type=int, default=2, help='runs at a time (default 2: one per core)')
@@ -307,8 +319,9 @@ def main():
                  'source the catkin workspace (devel/setup.bash) that built it first')
     os.makedirs(os.path.join(a.out, 'runs'), exist_ok=True)
     try:
-        cases = dm_sweep.grid([('mu', a.mu), ('f', a.f), ('seed', a.seeds)],
-                              name=lambda p: case_name(p['mu'], p['f'], p['seed']))
+        at = dict(a.seeds_at)
+        cases = dm_sweep.cases([{'mu': mu, 'f': f, 'seed': sd} for mu in a.mu for f in a.f for sd in at.get(f, a.seeds)],
+                               name=lambda p: case_name(p['mu'], p['f'], p['seed']))
     except ValueError as e:
         sys.exit('calibrate_cone_index: %s' % e)
 
@@ -390,6 +403,8 @@ def main():
             },
             'error_vs_finest': err,
         }
+        if a.note:
+            doc['provenance']['note'] = a.note
         path = os.path.join(a.out, 'cone_index_mu%g_d%g.yaml' % (mu, diameter))
         with open(path, 'w') as fh:
             fh.write('# Cone index calibration: CI [psi] -> cohesion factor f at mu = %g for particles of %g m\n'

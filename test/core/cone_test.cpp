@@ -307,17 +307,22 @@ TEST(ConePenetrometer, PidHoldsTheConeSpeedInTheSoil) {
   EXPECT_GT(r.density_consolidated, r.density_poured);
 }
 
-// The cone index rises with f, and each run lies within the band the calibration table
-// (config/calibration/, from the coarse sweep) predicts for its f.
+// The cone index rises with f, and each run lies within the band the calibration table of the
+// coarse particles (config/calibration/, from the sweep at the table's own level) predicts for its f.
 TEST(ConePenetrometer, ConeIndexRisesWithFWithinTheCalibrationBand) {
   const CiCalibration cal = CiCalibration::LoadFor(DM_CONFIG_DIR "/calibration", 0.06, 0.1);
-  ASSERT_EQ(cal.level, "coarse");
-  const double fs[2] = {0.3, 5.0};
+  const ConeParams level = Cone({"fidelity=" + cal.level});
+  ASSERT_DOUBLE_EQ(level.level.particle_diameter, cal.particle_diameter);
+  EXPECT_GE(cal.MinSeeds(), 3);  // every point of the table is a mean over seeds
+  ASSERT_GE(cal.points.size(), 3u);
+  // two of the cohesion factors the sweep ran, in the middle of the table
+  const size_t mid = cal.points.size() / 2;
+  const double fs[2] = {cal.points[mid - 1].f, cal.points[mid].f};
   ConeResult r[2];
   std::thread runs[2];
   for (int k = 0; k < 2; ++k)
     runs[k] = std::thread([&, k] {
-      r[k] = ConePenetrometer(Cone({"fidelity=coarse", "friction=0.1", "threads=1",
+      r[k] = ConePenetrometer(Cone({"fidelity=" + cal.level, "friction=0.1", "threads=1",
                                     "cohesion_factor=" + std::to_string(fs[k])}))
                  .Run();
     });

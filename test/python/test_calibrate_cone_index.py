@@ -77,8 +77,9 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
             # the stand-in's CI is 30 + 20 f + 2 (mean over the seeds): the finest level reads 10 % below at f = 1
             yaml.safe_dump({'level': 'medium', 'friction': 0.1, 'particle_diameter': 0.05, 'source': 'a test',
                             'points': {'f': [1.0], 'ci': [52.0 / 1.1]}}, fh)
-        cls.seeded = cls.sweep('0.5,1,3', '--seeds', '1,2,3', '--jobs', '1', '--finest', cls.finest,
-                               '--install', cls.install, out=cls.seeds_out)
+        cls.seeded = cls.sweep('0.5,1,3', '--seeds', '1,2,3', '--seeds-at', '3=1,2,4', '--jobs', '1',
+                               '--finest', cls.finest, '--install', cls.install, '--note', 'a note',
+                               out=cls.seeds_out)
         with open(os.path.join(ROOT, 'config', 'scenes', 'cone_penetrometer.yaml')) as fh:
             cls.tiny = yaml.safe_load(fh)['levels']['tiny']
 
@@ -145,7 +146,8 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         self.assertIn('x seeds 1,2,3), level tiny, 1 at a time', self.seeded.stdout)
         with open(os.path.join(self.seeds_out, 'runs', 'calls')) as fh:
             calls = sorted((float(c[0]), int(c[3])) for c in (line.split() for line in fh))
-        self.assertEqual(calls, [(f, s) for f in (0.5, 1.0, 3.0) for s in (1, 2, 3)])
+        cases = [(f, s) for f in (0.5, 1.0) for s in (1, 2, 3)] + [(3.0, s) for s in (1, 2, 4)]  # --seeds-at 3=1,2,4
+        self.assertEqual(calls, cases)
         name = 'cone_index_mu0.1_d%g.yaml' % self.tiny['particle_diameter']
         with open(os.path.join(self.seeds_out, name)) as fh:
             cal = yaml.safe_load(fh)
@@ -155,10 +157,12 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         self.assertEqual(pts['f'], [0.5, 1.0, 3.0])
         self.assertEqual(pts['seeds'], [3, 3, 3])
         for f, mean, sd in zip(pts['f'], pts['ci_mean'], pts['ci_std']):
-            self.assertAlmostEqual(mean, 30 + 20 * f + 2, places=3)  # the stand-in's CI, averaged over the seeds
-            self.assertAlmostEqual(sd, 2.0, places=3)                # its sample std over the seeds
-        self.assertEqual(sorted(zip(cal['runs']['f'], cal['runs']['seed'])),
-                         [(f, s) for f in (0.5, 1.0, 3.0) for s in (1, 2, 3)])
+            # the stand-in's CI (30 + 20 f + 2 (seed - 1)), its mean and sample std over the seeds run
+            ci = [30 + 20 * f + 2 * (s - 1) for s in ((1, 2, 4) if f == 3.0 else (1, 2, 3))]
+            m = sum(ci) / 3.0
+            self.assertAlmostEqual(mean, m, places=3)
+            self.assertAlmostEqual(sd, (sum((c - m) ** 2 for c in ci) / 2.0) ** 0.5, places=3)
+        self.assertEqual(sorted(zip(cal['runs']['f'], cal['runs']['seed'])), cases)
         # the table is fitted to the means: it passes through them at the ends
         self.assertAlmostEqual(cal['table'][0][0], round(pts['ci_mean'][0], 1), places=6)
         self.assertAlmostEqual(cal['table'][-1][0], round(pts['ci_mean'][-1], 1), places=6)
@@ -170,7 +174,8 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         head = subprocess.run(['git', '-C', ROOT, 'rev-parse', 'HEAD'], stdout=subprocess.PIPE,
                               universal_newlines=True).stdout.strip()
         self.assertTrue(prov['commit'].startswith(head), prov['commit'])
-        self.assertEqual(prov['seeds'], [1, 2, 3])
+        self.assertEqual(prov['seeds'], [1, 2, 3, 4])
+        self.assertEqual(prov['note'], 'a note')
         self.assertEqual(prov['soil_file'], 'config/soils/nominal_clay.yaml')
         with open(os.path.join(ROOT, 'config', 'soils', 'nominal_clay.yaml'), 'rb') as fh:
             self.assertEqual(prov['soil_sha256'], hashlib.sha256(fh.read()).hexdigest())
