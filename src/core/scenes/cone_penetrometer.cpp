@@ -47,20 +47,7 @@ ConeParams ConeParams::Read(const YamlReader& y) {
   ConeParams p;
   p.file = y.file();
   p.soil = ReadSceneSoil(y, "cone_penetrometer");
-  // the fidelity level: every level is checked, the named one is used
-  const std::string fidelity = y.String("fidelity");
-  const YamlReader levels = y.Child("levels");
-  std::string names;
-  bool found = false;
-  for (const std::string& name : levels.Keys()) {
-    const ConeLevel l = ReadLevel(levels.Child(name), name);
-    names += (names.empty() ? "" : ", ") + name;
-    if (name == fidelity) {
-      p.level = l;
-      found = true;
-    }
-  }
-  if (!found) y.Fail("fidelity", "no level '" + fidelity + "' under levels: (" + names + ")");
+  p.level = ReadFidelityLevel<ConeLevel>(y, ReadLevel);  // every level checked, the named one used
   // the soil: f directly, or from a requested cone index through a calibration table
   // (through the table of the level's particle size and the friction: CI(f) depends on both)
   const double f_file = y.Has("cohesion_factor") ? y.Double("cohesion_factor") : 1.0;

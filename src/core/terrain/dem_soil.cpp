@@ -39,20 +39,7 @@ DemSoilParams DemSoilParams::Read(const YamlReader& y) {
   DemSoilParams p;
   p.file = y.file();
   p.soil = SoilParams::Read(YamlReader::Load(y.ResolvePath(y.String("soil"))));
-  // the fidelity level: every level is checked, the named one is used
-  const std::string fidelity = y.String("fidelity");
-  const YamlReader levels = y.Child("levels");
-  std::string names;
-  bool found = false;
-  for (const std::string& name : levels.Keys()) {
-    const SoilBinLevel l = ReadBinLevel(levels.Child(name), name);
-    names += (names.empty() ? "" : ", ") + name;
-    if (name == fidelity) {
-      p.level = l;
-      found = true;
-    }
-  }
-  if (!found) y.Fail("fidelity", "no level '" + fidelity + "' under levels: (" + names + ")");
+  p.level = ReadFidelityLevel<SoilBinLevel>(y, ReadBinLevel);  // every level checked, the named one used
   p.friction = y.DoubleIn("friction", 0.0, 2.0);
   // the soil: f directly, or from a requested cone index through the calibration table made at
   // this level's particle size

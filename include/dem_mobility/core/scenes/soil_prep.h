@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
+#include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_system.h"
 
 namespace dem_mobility::core {
 
-class YamlReader;
 
 /// Positions of `count` particles of diameter d on a jittered square lattice (spacing `spacing`
 /// d) over the floor z = 0, layer after layer, inside the region where `inside(x, y)` holds
@@ -123,6 +123,28 @@ struct CylinderBed {
   double wall_height = 0.0;  ///< of the container's side
 };
 CylinderBed AddCylinderBed(DemSystem* s, double radius, int count, int segments, unsigned seed);
+
+/// The scene's fidelity level: every entry under `levels:` is read (and so checked) with
+/// `read(reader, name)`, the one named by `fidelity:` is returned; ConfigError naming `fidelity`
+/// and the known levels otherwise.
+template <class Level, class Read>
+Level ReadFidelityLevel(const YamlReader& y, Read&& read) {
+  const std::string fidelity = y.String("fidelity");
+  const YamlReader levels = y.Child("levels");
+  std::string names;
+  Level chosen;
+  bool found = false;
+  for (const std::string& name : levels.Keys()) {
+    Level l = read(levels.Child(name), name);
+    names += (names.empty() ? "" : ", ") + name;
+    if (name == fidelity) {
+      chosen = std::move(l);
+      found = true;
+    }
+  }
+  if (!found) y.Fail("fidelity", "no level '" + fidelity + "' under levels: (" + names + ")");
+  return chosen;
+}
 
 /// The `threads` key of a scene (OpenMP threads, default 1, in [1, 256]).
 int ReadThreads(const YamlReader& y);
