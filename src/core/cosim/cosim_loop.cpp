@@ -8,14 +8,37 @@
 
 namespace dem_mobility::core {
 
+namespace {
+
+MobilitySample Sample(const VehicleCoSim& sim, double t, double x, const DriverCommand& cmd) {
+  const Vehicle& veh = sim.vehicle();
+  MobilitySample s{t, x, veh.ForwardSpeed(), cmd.speed_command, veh.DriveShaftSpeed(), veh.AppliedDriveTorque(),
+                   cmd.brake_effort, cmd.wot_limited};
+  const double r = veh.tire().radius;
+  for (int i = 0; i < kWheels; ++i) {
+    const WheelState w = veh.GetWheelState(i);
+    const double rolling = veh.WheelSpeed(i) * r;
+    s.slip[i] = std::abs(rolling) >= 0.05 ? 1.0 - w.velocity.x() / rolling : 0.0;
+    const WheelWrench& f = veh.wheel_wrench(i);
+    s.sinkage[i] = f.sinkage;
+    s.traction += f.force.x();
+  }
+  s.thrust = veh.AppliedDriveTorque() / veh.driveline_reduction() / r;
+  return s;
+}
+
+}  // namespace
+
 MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, DriverPort& driver, CoSimObserver* observer) {
   const MobilityRunParams& p = sim.params();
   MobilityRunResult r;
   r.dt = sim.dt();
   r.dt_crit = sim.limit().dt_crit;
   r.dt_limit_element = sim.limit().element;
-  r.terrain_model = terrain.description().model;
-  r.cone_index = terrain.description().cone_index;
+  r.terrain = terrain.description();
+  r.terrain_model = r.terrain.model;
+  r.cone_index = r.terrain.cone_index;
+  r.coupling_interval = sim.coupling_interval();
   Vehicle& veh = sim.vehicle();
   const double dt = sim.dt();
   const auto wall0 = std::chrono::steady_clock::now();
@@ -50,11 +73,17 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
           veh.SetBrakeEffort(cmd.brake_effort);
         }
         if (k % sample_every == 0) {
-          r.history.push_back({t, veh.ChassisFramePosition().x() - x0, v, cmd.speed_command, w_ds,
-                               veh.AppliedDriveTorque(), cmd.brake_effort, cmd.wot_limited});
+          r.history.push_back(Sample(sim, t, veh.ChassisFramePosition().x() - x0, cmd));
           if (t >= p.plateau.stall_time && v < p.plateau.stall_speed && cmd.speed_command > p.plateau.stall_speed) {
             r.ended_early = true;
             break;
+          }
+          if (p.end_when_steady && t >= p.plateau.window) {
+            const std::string s = DetectSpeedMadeGood(r.history, p.plateau, p.driver.v_max).status;
+            if (s == "steady" || s == "command_limited") {
+              r.ended_early = true;
+              break;
+            }
           }
         }
         if (k >= run_steps) break;
@@ -74,6 +103,7 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
   r.sim_time = r.history.empty() ? 0.0 : r.history.back().t;
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   r.smg = DetectSpeedMadeGood(r.history, p.plateau, p.driver.v_max);
+  r.steady = SteadyWindowFigures(r.history, p.plateau.window, veh.system().TotalMass(), p.grade_deg);
   return r;
 }
 

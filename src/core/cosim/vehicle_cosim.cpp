@@ -25,7 +25,7 @@ VehicleCoSim::VehicleCoSim(const MobilityRunParams& p, const VehicleSpec& spec) 
 void VehicleCoSim::Exchange(TerrainPort& terrain) {
   for (int i = 0; i < kWheels; ++i) states_[i] = vehicle_->GetWheelState(i);
   // the terrain advances to the next exchange: one coupling interval of vehicle steps
-  terrain.Exchange(step(), time(), dt_ * p_.coupling_interval, states_, &wrenches_);
+  terrain.Exchange(step(), time(), dt_ * coupling_, states_, &wrenches_);
   DM_THROW_UNLESS(wrenches_.size() == kWheels, "the terrain answered step ", step(), " with ", wrenches_.size(),
                   " wrenches for ", kWheels, " wheels");
   for (int i = 0; i < kWheels; ++i) {
@@ -61,7 +61,24 @@ void VehicleCoSim::Start(TerrainPort& terrain) {
   limit_ = sys.CriticalTimeStep();
   const TimeStepLimit contact = vehicle_->WheelContactLimit(wrenches_[0].stiffness, wrenches_[0].damping);
   if (contact.dt_crit < limit_.dt_crit) limit_ = contact;
-  const double dt = p_.time_step > 0.0 ? p_.time_step : p_.time_step_safety * limit_.dt_crit;
+  double dt = p_.time_step > 0.0 ? p_.time_step : p_.time_step_safety * limit_.dt_crit;
+  int coupling = p_.coupling_interval;
+  const double h = terrain.description().time_step;
+  if (h > 0.0) {
+    if (p_.time_step <= 0.0) {
+      const long m = std::max(1L, static_cast<long>(std::ceil(h / dt - 1e-9)));
+      dt = h / m;
+      coupling = static_cast<int>(m * p_.coupling_interval);
+    } else {
+      const double ratio = dt * coupling / h;
+      const long n = std::lround(ratio);
+      if (n < 1 || std::abs(ratio - n) > 1e-6 * ratio)
+        throw ConfigError(detail::Concat(p_.file, ": time_step: the exchange interval dt x coupling_interval = ",
+                                         dt * coupling, " s is not a whole multiple of the terrain's step ", h, " s (",
+                                         terrain.description().file, ", level '", terrain.description().fidelity,
+                                         "'); use time_step: auto"));
+    }
+  }
   if (!(dt <= limit_.dt_crit))
     throw ConfigError(detail::Concat(p_.file, ": time_step: time step dt = ", dt, " s is above the critical step ",
                                      limit_.dt_crit, " s of ", limit_.element, " (", limit_.detail, "); use dt <= ",
@@ -72,6 +89,7 @@ void VehicleCoSim::Start(TerrainPort& terrain) {
     throw ConfigError(p_.file + ": time_step: " + e.what());
   }
   dt_ = dt;
+  coupling_ = coupling;
   checked_stiffness_ = wrenches_[0].stiffness;
   checked_damping_ = wrenches_[0].damping;
   settle_steps_ = std::lround(p_.settle_time / dt_);
@@ -80,7 +98,7 @@ void VehicleCoSim::Start(TerrainPort& terrain) {
 void VehicleCoSim::Step(TerrainPort& terrain) {
   MultibodySystem& sys = vehicle_->system();
   sys.BeginStep();
-  if (sys.step_count() % p_.coupling_interval == 0) Exchange(terrain);
+  if (sys.step_count() % coupling_ == 0) Exchange(terrain);
   sys.EndStep();
 }
 

@@ -72,6 +72,15 @@ void DemSystem::RemoveParticle(int id) {
   ps_.Remove(id);
 }
 
+void DemSystem::set_plastic_deformation(int id, double dp) {
+  DM_THROW_UNLESS(std::isfinite(dp) && dp >= 0.0, "particle ", id, ": plastic deformation ", dp, " must be finite and >= 0");
+  const int i = ps_.LiveSlot(id);
+  if (finalized_) ledger_.exchanged -= ParticleEnergy(EnergyTerms(), ps_, lists_, i);
+  ps_.plastic[i] = dp;
+  ps_.adhesion_max[i] = MaxAdhesionForce(soil_, dp);
+  if (finalized_) ledger_.exchanged += ParticleEnergy(EnergyTerms(), ps_, lists_, i);
+}
+
 void DemSystem::set_threads(int threads) {
   DM_THROW_UNLESS(threads >= 1, "DEM threads ", threads, " must be >= 1");
   settings_.threads = threads;

@@ -7,6 +7,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/terrain/terrain_model.h"
 
 namespace dem_mobility::core {
 
@@ -14,9 +15,16 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
   MobilityRunParams p;
   p.file = y.file();
   const std::string scene = y.String("scene");
-  if (scene != "road_slope") y.Fail("scene", "expected 'road_slope', found '" + scene + "'");
+  if (scene != "road_slope" && scene != "soil_slope")
+    y.Fail("scene", "expected 'road_slope' or 'soil_slope', found '" + scene + "'");
+  p.kind = scene;
   p.vehicle_file = y.ResolvePath(y.String("vehicle"));
   p.terrain_file = y.ResolvePath(y.String("terrain"));
+  if (y.Has("terrain_overrides")) {
+    const YamlReader o = y.Child("terrain_overrides");
+    for (const std::string& k : o.Keys()) p.terrain_overrides.push_back(k + "=" + o.String(k));
+    o.Finish();
+  }
   p.grade_deg = y.DoubleIn("grade_deg", -45.0, 45.0);
   p.duration = y.DoubleIn("duration", 1e-3, 3600.0);
   p.settle_time = y.DoubleIn("settle_time", 0.0, 10.0, 0.5);
@@ -32,6 +40,7 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
   p.plateau.tolerance = res.Positive("plateau_tolerance", 0.05);
   p.plateau.stall_speed = res.Positive("stall_speed", 0.2);
   p.plateau.stall_time = res.Positive("stall_time", 5.0);
+  p.end_when_steady = res.Bool("end_when_steady", false);
   res.Finish();
   y.Finish();
   return p;
@@ -77,6 +86,31 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
   return s;
 }
 
+SteadyFigures SteadyWindowFigures(const std::vector<MobilitySample>& h, double window, double mass, double grade_deg) {
+  SteadyFigures f;
+  if (h.empty()) return f;
+  const double a = grade_deg * M_PI / 180.0, wn = mass * 9.81 * std::cos(a);
+  const double t_end = h.back().t;
+  double pull = 0.0, thrust = 0.0;
+  for (auto it = h.rbegin(); it != h.rend() && it->t >= t_end - window; ++it) {
+    ++f.samples;
+    for (int i = 0; i < kWheels; ++i) {
+      f.slip[i] += it->slip[i];
+      f.sinkage[i] += it->sinkage[i];
+    }
+    pull += it->traction;
+    thrust += it->thrust;
+  }
+  for (int i = 0; i < kWheels; ++i) {
+    f.slip[i] /= f.samples;
+    f.sinkage[i] /= f.samples;
+  }
+  f.traction_coefficient = pull / f.samples / wn;
+  f.motion_resistance = (thrust - pull) / f.samples / wn;
+  f.drawbar_margin = f.traction_coefficient - std::tan(a);
+  return f;
+}
+
 std::string MobilityRunResult::Status() const {
   if (!error.empty()) return "error";
   if (interrupted) return "interrupted";
@@ -84,23 +118,31 @@ std::string MobilityRunResult::Status() const {
 }
 
 ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParams& p,
-                              const std::vector<std::pair<std::string, long>>& published) {
-  ResultFile f(p.file, "road_slope");
+                              const std::vector<std::pair<std::string, long>>& published, const TerrainModel* terrain) {
+  ResultFile f(p.file, p.kind);
   f.SetStatus(r.Status(), r.error);
   f.Set("grade_deg", p.grade_deg);
   f.Set("terrain", p.terrain_file);
   f.Set("terrain_model", r.terrain_model);
   f.Set("cone_index_psi", r.cone_index);
+  if (!r.terrain.fidelity.empty()) f.Set("fidelity", r.terrain.fidelity);
   f.Set("speed_made_good", r.smg.value);
   f.Set("speed_made_good_mph", r.smg.value / 0.44704);
   f.Set("verdict", r.smg.status);
   f.Set("window_slope", r.smg.window_slope);
   f.Set("window_speed_std", r.smg.window_std);
   f.Set("ended_early", r.ended_early);
+  const SteadyFigures& s = r.steady;
+  f.Set("window_samples", s.samples);
+  f.SetFlow("slip", std::vector<double>(s.slip.begin(), s.slip.end()));
+  f.SetFlow("sinkage", std::vector<double>(s.sinkage.begin(), s.sinkage.end()));
+  f.Set("traction_coefficient", s.traction_coefficient);
+  f.Set("motion_resistance_coefficient", s.motion_resistance);
+  f.Set("drawbar_margin", s.drawbar_margin);
   f.Set("time_step", r.dt);
   f.Set("critical_time_step", r.dt_crit);
   f.Set("critical_element", r.dt_limit_element);
-  f.Set("coupling_interval", p.coupling_interval);
+  f.Set("coupling_interval", r.coupling_interval);
   f.Set("steps", r.steps);
   f.Set("exchanges", r.exchanges);
   f.Set("driver_updates", r.driver_updates);
@@ -109,17 +151,24 @@ ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParam
   f.Set("real_time_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0);
   f.Set("interrupted", r.interrupted);
   if (!published.empty()) f.SetCounts("published", published);
+  if (terrain) terrain->Describe(&f);
   return f;
 }
 
 void WriteMobilityHistory(const MobilityRunResult& r, const std::string& path) {
   std::ofstream out(path);
   if (!out) throw ConfigError(path + ": cannot write the history file");
-  out << "t,x,speed,speed_command,drive_shaft_speed,drive_torque,brake_effort,wot_limited\n";
-  out << std::setprecision(8);
-  for (const auto& s : r.history)
+  out << "t,x,speed,speed_command,drive_shaft_speed,drive_torque,brake_effort,wot_limited,traction,thrust";
+  for (const char* w : kWheelNames) out << ",slip_" << w;
+  for (const char* w : kWheelNames) out << ",sinkage_" << w;
+  out << "\n" << std::setprecision(8);
+  for (const auto& s : r.history) {
     out << s.t << "," << s.x << "," << s.speed << "," << s.speed_command << "," << s.drive_shaft_speed << ","
-        << s.drive_torque << "," << s.brake_effort << "," << s.wot_limited << "\n";
+        << s.drive_torque << "," << s.brake_effort << "," << s.wot_limited << "," << s.traction << "," << s.thrust;
+    for (double v : s.slip) out << "," << v;
+    for (double v : s.sinkage) out << "," << v;
+    out << "\n";
+  }
 }
 
 }  // namespace dem_mobility::core

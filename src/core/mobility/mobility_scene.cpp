@@ -6,7 +6,7 @@ namespace dem_mobility::core {
 
 MobilityRun::MobilityRun(const MobilityRunParams& p)
     : spec_(VehicleSpec::Load(p.vehicle_file)),
-      terrain_(LoadTerrainModel(p.terrain_file, TerrainVehicle{spec_.tire, kWheels})),
+      terrain_(LoadTerrainModel(p.terrain_file, TerrainVehicle{spec_.tire, kWheels}, p.terrain_overrides)),
       port_(*terrain_),
       driver_(p.driver, spec_),
       sim_(p, spec_) {

@@ -68,7 +68,7 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
               r.smg.value / 0.44704, r.smg.status.c_str(), r.smg.window_slope);
   std::printf("run: %ld steps, %.2f s simulated in %.2f s wall (real-time factor %.2f)\n", r.steps, r.sim_time,
               r.wall_time, r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0);
-  return MobilityResultFile(r, p);
+  return MobilityResultFile(r, p, {}, &run.terrain());
 }
 
 ResultFile RunPourScene(const YamlReader& reader, const SceneRunOptions&) {
@@ -166,6 +166,7 @@ ResultFile RunCompressionScene(const YamlReader& reader, const SceneRunOptions&)
 const std::vector<SceneKind>& SceneKinds() {
   static const std::vector<SceneKind> kinds = {
       {"road_slope", "the vehicle accelerating up a grade on a terrain: speed-made-good", &RunMobilityScene},
+      {"soil_slope", "the vehicle accelerating up a grade on a moving DEM soil patch: speed-made-good", &RunMobilityScene},
       {"dem_pour", "soil preparation: pour, settle, consolidate with a lid, release", &RunPourScene},
       {"cone_penetrometer", "the cone penetrometer: cone index of a prepared soil", &RunConeScene},
       {"uniaxial_compression", "piston-cylinder compression: bulk density against pressure", &RunCompressionScene},

@@ -2,12 +2,14 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_shapes.h"
+#include "dem_mobility/core/terrain/soil_patch.h"
 
 namespace dem_mobility::core {
 
@@ -101,6 +103,13 @@ DemSoilParams DemSoilParams::Read(const YamlReader& y) {
     p.wall_margin = t.DoubleIn("margin", 0.0, 1.0, 0.0);
     t.Finish();
   }
+  if (y.Has("patch")) {
+    p.patch = SoilPatchParams::Read(y.Child("patch"));
+    const double h = p.patch.leveling_ahead + p.patch.leveling_radius;
+    if (h > 0.5 * p.level.length)
+      y.Fail("patch.leveling.ahead", detail::Concat("the leveling cylinder (", h, " m ahead of the front wheels) must lie within half the bin's length (",
+                                                    0.5 * p.level.length, " m)"));
+  }
   return p;
 }
 
@@ -147,6 +156,8 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
   DemSettings st;
   st.threads = p.threads;
   st.max_overlap = p.max_overlap;
+  // a moving patch re-emits a layer at a time next to the soil's front: room for the new pairs
+  if (p.patch.enabled) st.list_slack = 6;
   dem_ = std::make_unique<DemSystem>(p.soil, st);
   DemSystem& s = *dem_;
   const Vector3d o = p.origin - Vector3d(0.0, 0.5 * l.width, 0.0);
@@ -157,7 +168,11 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
   double top = 0.0;
   for (const Vector3d& x : lattice) top = std::max(top, x.z());
   wall_height_ = top + 2.0 * d;
-  for (DemWall& w : MakeOpenBoxWalls(l.length, l.width, wall_height_)) {
+  // a moving patch's floor and sides reach over the whole travel (their material stays put)
+  const double reach = p.patch.enabled ? l.length + p.patch.travel : l.length;
+  std::vector<DemWall> box = MakeOpenBoxWalls(reach, l.width, wall_height_);
+  box[2] = MakeQuadWall("x1", {l.length, 0, 0}, {0, l.width, 0}, {0, 0, wall_height_});
+  for (DemWall& w : box) {
     for (Vector3d& v : w.mesh.vertices) v += o;
     container_.push_back(s.AddWall(std::move(w)));
   }
@@ -179,6 +194,22 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
     centres_.push_back(w.position);
     tire_walls_.push_back(s.AddWall(std::move(w)));
   }
+  if (p.patch.enabled) {
+    // the leveling cylinder (axis along y) and plate, parked above until the patch starts
+    const double span = l.width - d;
+    DemWall c = MakeRodWall("leveling_cylinder", p.patch.leveling_radius, span, 16);
+    for (Vector3d& v : c.mesh.vertices) v = Vector3d(v.x(), -v.z() + 0.5 * span, v.y());
+    c.fast = true;
+    c.friction = p.tire_friction;
+    c.position = o + Vector3d(0.5 * l.length, 0.5 * l.width, wall_height_ + 20.0);
+    cylinder_ = s.AddWall(std::move(c));
+    DemWall pl = MakeQuadWall("leveling_plate", Vector3d(0, -0.5 * span, 0), Vector3d(p.patch.plate_length, 0, 0),
+                              Vector3d(0, span, 0));
+    pl.fast = true;
+    pl.friction = p.tire_friction;
+    pl.position = o + Vector3d(0.5 * l.length, 0.5 * l.width, wall_height_ + 25.0);
+    plate_ = s.AddWall(std::move(pl));
+  }
   for (const Vector3d& x : lattice) s.AddParticle(o + x);
   s.Finalize(l.time_step);
   prep_ = std::make_unique<SoilPreparation>(&s, lid_, l.length * l.width, o.z() + wall_height_ + 1.0, p.prep,
@@ -194,8 +225,25 @@ DemSoilBin::DemSoilBin(const DemSoilBin& o)
       container_(o.container_),
       centres_(o.centres_),
       lid_(o.lid_),
+      cylinder_(o.cylinder_),
+      plate_(o.plate_),
       wall_height_(o.wall_height_),
-      surface_(o.surface_) {}
+      surface_(o.surface_),
+      shift_(o.shift_) {}
+
+void DemSoilBin::ShiftZ(double dz) {
+  DemSystem& s = *dem_;
+  std::vector<int> ids;
+  s.ForEachParticle([&](int id, const Vector3d&, const Vector3d&) { ids.push_back(id); });
+  for (int id : ids) s.mutable_position(id).z() += dz;
+  for (int w = 0; w < s.num_walls(); ++w) {
+    s.mutable_wall(w).position.z() += dz;
+    s.mutable_wall(w).wrench_point.z() += dz;
+  }
+  for (Vector3d& c : centres_) c.z() += dz;
+  surface_ += dz;
+  shift_ += dz;
+}
 
 void DemSoilBin::PrepareStep() {
   prep_->Step();
@@ -233,18 +281,75 @@ WheelWrench DemSoilBin::Wrench(int k) const {
 
 DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels)
     : bin_(std::make_unique<DemSoilBin>(p, tire, wheels)) {
+  const auto t0 = std::chrono::steady_clock::now();
   description_.file = p.file;
   description_.model = "dem_soil";
   description_.cone_index = p.ConeIndex();
+  description_.time_step = p.level.time_step;
+  description_.fidelity = p.level.name;
   while (!bin_->prepared()) bin_->PrepareStep();
-  // the display surface: the bin's consolidated top
+  // the prepared surface to z = 0: the vehicle starts there with its tires touching
+  bin_->ShiftZ(-bin_->surface_height());
+  if (p.patch.enabled) patch_ = std::make_unique<SoilPatch>(bin_.get(), p.patch, p.seed);
+  // the display surface: the bin's consolidated top (with a patch, over the whole travel)
   const SoilBinLevel& l = p.level;
   const double z = bin_->surface_height();
   const Vector3d o = p.origin - Vector3d(0.0, 0.5 * l.width, 0.0);
-  surface_mesh_.vertices = {Vector3d(o.x(), o.y(), z), Vector3d(o.x() + l.length, o.y(), z),
-                            Vector3d(o.x() + l.length, o.y() + l.width, z), Vector3d(o.x(), o.y() + l.width, z)};
+  const double length = l.length + (p.patch.enabled ? p.patch.travel : 0.0);
+  surface_mesh_.vertices = {Vector3d(o.x(), o.y(), z), Vector3d(o.x() + length, o.y(), z),
+                            Vector3d(o.x() + length, o.y() + l.width, z), Vector3d(o.x(), o.y() + l.width, z)};
   surface_mesh_.faces = {{0, 1, 2}, {0, 2, 3}};
   wrenches_.assign(wheels, WheelWrench());
+  prepare_wall_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+DemSoilTerrain::~DemSoilTerrain() = default;
+
+TerrainDisplay DemSoilTerrain::Display() const {
+  TerrainDisplay d;
+  d.dem = &bin_->dem();
+  if (!patch_) return d;
+  d.walls = {bin_->leveling_cylinder(), bin_->leveling_plate()};
+  d.patch = true;
+  d.sphere_centre = patch_->sphere_centre();
+  d.sphere_radius = patch_->sphere_radius();
+  d.box_rear = patch_->box_rear();
+  d.box_front = patch_->box_front();
+  d.box_width = bin_->params().level.width;
+  d.floor_z = bin_->floor_z();
+  d.box_height = bin_->wall_height();
+  d.emitter_from = patch_->emitter_from();
+  d.emitter_to = patch_->emitter_to();
+  return d;
+}
+
+void DemSoilTerrain::Describe(ResultFile* r) const {
+  const DemSoilParams& p = bin_->params();
+  p.Describe(r);
+  r->Set("soil_time_step", p.level.time_step);
+  r->Set("particles", bin_->dem().num_alive());
+  r->Set("soil_depth", bin_->surface_height() - bin_->floor_z());
+  r->Set("soil_prepare_wall_time", prepare_wall_);
+  r->Set("soil_advance_wall_time", advance_wall_);
+  r->Set("soil_steps", bin_->dem().step_count());
+  r->Set("soil_neighbour_builds", bin_->dem().neighbour_builds());
+  r->Set("soil_wall_builds", bin_->dem().wall_builds());
+  if (!patch_) return;
+  const PatchStats& s = patch_->stats();
+  r->Set("patch_following", s.following);
+  r->Set("patch_travel", patch_->sphere_centre().x() - bin_->params().origin.x() - 0.5 * p.level.length);
+  r->Set("patch_reemitted", s.reemitted);
+  r->Set("patch_strays", s.strays);
+  r->Set("patch_template_copies", s.copies);
+  r->Set("patch_skipped_sites", s.skipped_sites);
+  r->Set("patch_initial_density", s.initial.density);
+  r->Set("patch_initial_surface", s.initial.surface);
+  r->Set("patch_checks", s.checks);
+  r->Set("patch_density_ratio", s.density_ratio_mean);
+  r->Set("patch_density_ratio_min", s.density_ratio_min);
+  r->Set("patch_density_ratio_max", s.density_ratio_max);
+  r->Set("patch_surface_offset", s.surface_offset_mean);
+  r->Set("patch_surface_offset_max", s.surface_offset_max);
 }
 
 void DemSoilTerrain::Synchronize(long, double, const std::vector<WheelState>& states) {
@@ -264,8 +369,10 @@ void DemSoilTerrain::Advance(double dt) {
     throw SimulationError(detail::Concat("dem_soil (", bin_->params().file, "): the exchange step ", dt,
                                          " s is not a whole multiple of the soil's time step ", h,
                                          " s (levels.", bin_->params().level.name, ".time_step)"));
+  const auto t0 = std::chrono::steady_clock::now();
   const int W = bin_->wheels();
   std::vector<WheelWrench> sum(W);
+  std::vector<Vector3d> centres(W);
   for (long k = 1; k <= n; ++k) {
     // each tire moves on at its synchronized velocities to where it is at the end of this step
     for (int w = 0; w < W; ++w) {
@@ -276,7 +383,9 @@ void DemSoilTerrain::Advance(double dt) {
       if (angle > 0.0)
         s.orientation = Eigen::AngleAxisd(angle, s.angular_velocity.normalized()) * s.orientation;
       bin_->SetWheel(w, s);
+      centres[w] = s.position;
     }
+    if (patch_) patch_->BeforeStep(centres);
     bin_->Step();
     for (int w = 0; w < W; ++w) {
       const WheelWrench r = bin_->Wrench(w);
@@ -297,6 +406,7 @@ void DemSoilTerrain::Advance(double dt) {
     sum[w].normal_force /= n;
   }
   wrenches_ = sum;
+  advance_wall_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle) {
@@ -312,6 +422,8 @@ TerrainDescription DescribeDemSoilTerrain(const YamlReader& y) {
   d.file = y.file();
   d.model = "dem_soil";
   d.cone_index = p.ConeIndex();
+  d.time_step = p.level.time_step;
+  d.fidelity = p.level.name;
   return d;
 }
 

@@ -25,13 +25,14 @@ const TerrainKind& FindTerrainKind(const YamlReader& y) {
 }
 }  // namespace
 
-std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle) {
-  const YamlReader y = YamlReader::Load(terrain_file);
+std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
+                                               const std::vector<std::string>& overrides) {
+  const YamlReader y = YamlReader::LoadWithOverrides(terrain_file, overrides);
   return FindTerrainKind(y).make(y, vehicle);
 }
 
-TerrainDescription DescribeTerrain(const std::string& terrain_file) {
-  const YamlReader y = YamlReader::Load(terrain_file);
+TerrainDescription DescribeTerrain(const std::string& terrain_file, const std::vector<std::string>& overrides) {
+  const YamlReader y = YamlReader::LoadWithOverrides(terrain_file, overrides);
   return FindTerrainKind(y).describe(y);
 }
 

@@ -42,6 +42,10 @@ struct TerrainDescription {
   std::string file;
   std::string model;    ///< its `model:` (rigid_road, ...)
   double cone_index = std::numeric_limits<double>::quiet_NaN();  ///< soil strength [psi]
+  /// The terrain's own time step [s] (a DEM soil's; 0: none): the exchanges must come at whole
+  /// multiples of it.
+  double time_step = 0.0;
+  std::string fidelity;  ///< the terrain's fidelity level (empty: none)
 };
 
 /// Vehicle -> driver at every control step.

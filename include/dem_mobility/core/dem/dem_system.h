@@ -84,6 +84,10 @@ class DemSystem {
   double plastic_deformation(int id) const { return ps_.Get(ps_.plastic, id); }
   Eigen::Vector3d& mutable_velocity(int id) { return ps_.v[ps_.LiveSlot(id)]; }
   Eigen::Vector3d& mutable_position(int id) { return ps_.x[ps_.LiveSlot(id)]; }
+  /// Sets a live particle's plastic deformation [m] and with it its maximum adhesion (the
+  /// consolidation-dependent adhesion of the soil law): a particle re-emitted with the state of the
+  /// consolidated soil it replaces.
+  void set_plastic_deformation(int id, double dp);
   /// Calls f(id, position, velocity) for every live particle, in storage order (cheap: no copies).
   template <class F>
   void ForEachParticle(F&& f) const {

@@ -4,17 +4,20 @@
 // the loop that produces them is the co-simulation's (cosim/cosim_loop.h).
 #pragma once
 
+#include <array>
 #include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "dem_mobility/core/cosim/exchange.h"
 #include "dem_mobility/core/vehicle/driver.h"
 
 namespace dem_mobility::core {
 
 class ResultFile;
 class YamlReader;
+class TerrainModel;
 
 /// Settings of the speed-made-good detector.
 struct PlateauParams {
@@ -26,7 +29,11 @@ struct PlateauParams {
 
 struct MobilityRunParams {
   std::string file;           ///< the scene file (for messages)
+  std::string kind = "road_slope";  ///< its `scene:` (road_slope or soil_slope: the same run)
   std::string vehicle_file, terrain_file;
+  /// key=value overrides of the terrain file (the scene's terrain_overrides map: a soil's
+  /// cone_index, fidelity, threads, seed)
+  std::vector<std::string> terrain_overrides;
   double grade_deg = 0.0;
   double duration = 40.0;
   double settle_time = 0.5;   ///< [s] brakes on, driver off, before the driver's t = 0
@@ -36,7 +43,8 @@ struct MobilityRunParams {
   DriverParams driver;
   PlateauParams plateau;
   double sample_rate = 100.0; ///< [Hz] history samples
-  /// Reads a scene file of kind `road_slope`; ConfigError names the file and key.
+  bool end_when_steady = false;  ///< end the run once the detector finds a plateau or the command reached
+  /// Reads a scene file of kind `road_slope` or `soil_slope`; ConfigError names the file and key.
   static MobilityRunParams Read(const YamlReader& y);
 };
 
@@ -44,6 +52,10 @@ struct MobilityRunParams {
 struct MobilitySample {
   double t, x, speed, speed_command, drive_shaft_speed, drive_torque, brake_effort;
   bool wot_limited;
+  std::array<double, kWheels> slip{};     ///< 1 - v / (omega r) per wheel (0 while omega r < 0.05 m/s)
+  std::array<double, kWheels> sinkage{};  ///< [m] per wheel, as the terrain reports it
+  double traction = 0.0;  ///< the terrain's pull on the wheels along the slope [N]
+  double thrust = 0.0;    ///< drive torque at the wheels over the tire radius [N]
 };
 
 struct SpeedMadeGood {
@@ -56,13 +68,25 @@ struct SpeedMadeGood {
 /// Judges the speed history: a plateau under full throttle, the command reached, or a stall.
 SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const PlateauParams& p, double v_max);
 
+/// Means over the detector's judging window (the steady state).
+struct SteadyFigures {
+  int samples = 0;
+  std::array<double, kWheels> slip{}, sinkage{};
+  double traction_coefficient = 0.0;   ///< terrain pull / (m g cos(grade))
+  double motion_resistance = 0.0;      ///< (thrust - pull) / (m g cos(grade))
+  double drawbar_margin = 0.0;         ///< traction_coefficient - tan(grade)
+};
+
 struct MobilityRunResult {
   SpeedMadeGood smg;
+  SteadyFigures steady;
+  TerrainDescription terrain;  ///< what ran (model, cone index, time step, fidelity)
   std::vector<MobilitySample> history;
   std::string terrain_model;  ///< the terrain that ran (its `model:`)
   double cone_index = std::numeric_limits<double>::quiet_NaN();  ///< its soil strength [psi]
   double dt = 0.0, dt_crit = 0.0;
   std::string dt_limit_element;
+  int coupling_interval = 1;  ///< vehicle steps per exchange in use
   long steps = 0, exchanges = 0, driver_updates = 0;
   double sim_time = 0.0, wall_time = 0.0;  ///< sim_time: from the driver's start
   bool ended_early = false;
@@ -72,10 +96,15 @@ struct MobilityRunResult {
   std::string Status() const;
 };
 
+/// The steady figures over the trailing `window` of the history (vehicle mass m, grade).
+SteadyFigures SteadyWindowFigures(const std::vector<MobilitySample>& h, double window, double mass, double grade_deg);
+
 /// The run's result file (speed-made-good, status, terrain, timing); `published` lists message
-/// counts by topic (the ROS run's).
+/// counts by topic (the ROS run's); `terrain`: the terrain model that ran, when in this process
+/// (its own figures: soil, level, patch checks).
 ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParams& p,
-                              const std::vector<std::pair<std::string, long>>& published = {});
+                              const std::vector<std::pair<std::string, long>>& published = {},
+                              const TerrainModel* terrain = nullptr);
 /// Writes the history as CSV to `path`.
 void WriteMobilityHistory(const MobilityRunResult& r, const std::string& path);
 

@@ -18,6 +18,8 @@ class MobilityRun {
   VehicleCoSim& sim() { return sim_; }
   Vehicle& vehicle() { return sim_.vehicle(); }
   TerrainPort& terrain_port() { return port_; }
+  const TerrainModel& terrain() const { return *terrain_; }
+  TerrainModel& mutable_terrain() { return *terrain_; }
   double dt() const { return sim_.dt(); }
 
  private:

@@ -36,6 +36,26 @@ struct SoilBinLevel {
   double hold_time = 0.5;           ///< [s] at the lid pressure
 };
 
+/// The moving soil patch (paper section 4.2, fig. 18): particles that leave a bounding sphere are
+/// re-emitted at once ahead of the vehicle; once the vehicle's wheels reach the sphere's initial
+/// centre, the sphere, the emitter and the leveling cylinder and plate follow them along the
+/// grade. Without the `patch:` map the bin is fixed.
+struct SoilPatchParams {
+  bool enabled = false;
+  double travel = 800.0;          ///< [m] the floor and side walls reach this far beyond the bin's front
+  double sphere_margin = 0.1;     ///< [m] of the sphere beyond the bed's half-diagonal
+  double template_length = 2.0;   ///< [m] the slice of the prepared bed the emitter lays down again
+  double seam_clearance = 0.8;    ///< [d] a template site closer than this to soil already there is skipped
+  double leveling_ahead = 2.1;    ///< [m] cylinder axis ahead of the front wheels' centres (at the start)
+  double leveling_radius = 0.1;   ///< [m]
+  double plate_length = 0.6;      ///< [m] plate behind the cylinder
+  double leveling_clearance = 0.25;  ///< [d] of the plate's underside above the initial surface
+  double check_from = 0.6, check_to = 1.4;  ///< [m] ahead of the front wheels' centres: the re-emitted soil checked there
+  double check_period = 0.05;     ///< [s] between checks
+  /// Reads the `patch` map; ConfigError names the file and key.
+  static SoilPatchParams Read(const YamlReader& y);
+};
+
 /// The keys a soil bin is read from (a dem_soil terrain file, or a scene that holds a bin).
 struct DemSoilParams {
   std::string file;
@@ -54,6 +74,7 @@ struct DemSoilParams {
   double tire_adhesion = 0.0;       ///< tire adhesion as a fraction of the particle's maximum
   double wall_margin = 0.0;         ///< tire candidate margin [m]; 0: the skin
   SoilPreparationParams prep;
+  SoilPatchParams patch;
   int threads = 1;
   unsigned seed = 1;
   double max_overlap = 0.4;         ///< overlap watchdog, fraction of d
@@ -101,8 +122,15 @@ class DemSoilBin {
   int tire_wall(int k) const { return tire_walls_[k]; }
   int lid_wall() const { return lid_; }
   double wall_height() const { return wall_height_; }
-  /// The bin's walls (floor and sides).
+  /// The bin's walls (floor, rear, front and sides, in this order).
   std::vector<int> container_walls() const { return container_; }
+  /// The moving patch's leveling cylinder and plate (-1 without a patch).
+  int leveling_cylinder() const { return cylinder_; }
+  int leveling_plate() const { return plate_; }
+  /// The floor's z in the scene (after any ShiftZ).
+  double floor_z() const { return p_.origin.z() + shift_; }
+  /// Moves the soil and every wall by dz along z (the prepared surface to z = 0 under a vehicle).
+  void ShiftZ(double dz);
 
  private:
   DemSoilParams p_;
@@ -111,27 +139,41 @@ class DemSoilBin {
   std::unique_ptr<SoilPreparation> prep_;
   std::vector<int> tire_walls_, container_;
   std::vector<Eigen::Vector3d> centres_;
-  int lid_ = -1;
-  double wall_height_ = 0.0, surface_ = 0.0;
+  int lid_ = -1, cylinder_ = -1, plate_ = -1;
+  double wall_height_ = 0.0, surface_ = 0.0, shift_ = 0.0;
 };
 
-/// The dem_soil terrain model: a DemSoilBin prepared when it is built, its tires following the
-/// vehicle's wheels. Advance(dt) takes dt / time_step DEM steps (dt must be a whole multiple of
+class SoilPatch;
+
+/// The dem_soil terrain model: a DemSoilBin prepared when it is built (its surface then moved to
+/// z = 0, where the vehicle starts with its tires touching), its tires following the vehicle's
+/// wheels; with a `patch:` map, a moving soil patch (soil_patch.h). Advance(dt) takes dt / time_step DEM steps (dt must be a whole multiple of
 /// the soil's step), moving each tire on from its synchronized pose at its synchronized velocity;
 /// the wrenches it returns are the means over those steps, so the impulse the wheels receive is
 /// exactly minus the one the particles received.
 class DemSoilTerrain final : public TerrainModel {
  public:
   DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels);
+  ~DemSoilTerrain() override;
   const TerrainDescription& description() const override { return description_; }
   void Synchronize(long step, double t, const std::vector<WheelState>& states) override;
   void GetWrenches(std::vector<WheelWrench>* wrenches) const override;
   void Advance(double dt) override;
   const TriMesh& Surface() const override { return surface_mesh_; }
+  TerrainDisplay Display() const override;
+  void Describe(ResultFile* r) const override;
   const DemSoilBin& bin() const { return *bin_; }
+  DemSoilBin& mutable_bin() { return *bin_; }
+  /// The moving patch (nullptr without one).
+  const SoilPatch* patch() const { return patch_.get(); }
+  /// Wall seconds spent preparing the soil and advancing it.
+  double prepare_wall_time() const { return prepare_wall_; }
+  double advance_wall_time() const { return advance_wall_; }
 
  private:
   std::unique_ptr<DemSoilBin> bin_;
+  std::unique_ptr<SoilPatch> patch_;
+  double prepare_wall_ = 0.0, advance_wall_ = 0.0;
   TerrainDescription description_;
   TriMesh surface_mesh_;
   std::vector<WheelState> states_;

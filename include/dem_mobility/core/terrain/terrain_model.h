@@ -6,6 +6,7 @@
 // terrain nodelet and the in-process runner serve either.
 #pragma once
 
+#include <Eigen/Core>
 #include <functional>
 #include <memory>
 #include <string>
@@ -18,6 +19,20 @@
 namespace dem_mobility::core {
 
 class YamlReader;
+class ResultFile;
+class DemSystem;
+
+/// What a terrain shows besides its surface (the ROS layer draws it): its particles, its tools
+/// (walls, drawn at their poses) and a moving soil patch's sphere and box.
+struct TerrainDisplay {
+  const DemSystem* dem = nullptr;  ///< the particles (nullptr: none)
+  std::vector<int> walls;          ///< walls of `dem` to draw (the patch's tools)
+  bool patch = false;
+  Eigen::Vector3d sphere_centre = Eigen::Vector3d::Zero();
+  double sphere_radius = 0.0;
+  double box_rear = 0.0, box_front = 0.0, box_width = 0.0, floor_z = 0.0, box_height = 0.0;
+  double emitter_from = 0.0, emitter_to = 0.0;  ///< the layer the emitter fills (x)
+};
 
 class TerrainModel {
  public:
@@ -33,6 +48,11 @@ class TerrainModel {
   virtual void Advance(double dt) = 0;
   /// The surface as triangles (world frame), for display.
   virtual const TriMesh& Surface() const = 0;
+  /// Its particles and tools, for display (a rigid terrain has none).
+  virtual TerrainDisplay Display() const { return TerrainDisplay(); }
+  /// Writes the terrain's own figures into a run's result (a soil's level, f, cone index and
+  /// table, the moving patch's checks); a rigid terrain has none.
+  virtual void Describe(ResultFile* /*r*/) const {}
 };
 
 /// What a terrain needs of the vehicle: its wheels' geometry.
@@ -52,10 +72,12 @@ struct TerrainKind {
 /// The terrain kinds there are.
 const std::vector<TerrainKind>& TerrainKinds();
 
-/// Builds the terrain described by `terrain_file` for the wheels of `vehicle`. Throws ConfigError
-/// naming file and key of bad input (an unknown `model:` lists the known ones).
-std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle);
-/// What `terrain_file` describes (model and cone index), without building it.
-TerrainDescription DescribeTerrain(const std::string& terrain_file);
+/// Builds the terrain described by `terrain_file` (with `key=value` overrides, a scene's
+/// terrain_overrides) for the wheels of `vehicle`. Throws ConfigError naming file and key of bad
+/// input (an unknown `model:` lists the known ones).
+std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
+                                               const std::vector<std::string>& overrides = {});
+/// What `terrain_file` describes (model, cone index, time step, level), without building it.
+TerrainDescription DescribeTerrain(const std::string& terrain_file, const std::vector<std::string>& overrides = {});
 
 }  // namespace dem_mobility::core

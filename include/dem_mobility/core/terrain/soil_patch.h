@@ -1,0 +1,118 @@
+// The moving soil patch (paper section 4.2, fig. 18) over a prepared DemSoilBin: a bounding
+// sphere, an emitter ahead of the vehicle, and a leveling cylinder and plate at the initial soil
+// height. A particle that leaves the sphere is removed and re-emitted at once, so the particle
+// count never changes. Once the centroid of the wheel centres (the terrain sees the wheels, not
+// the chassis) reaches the sphere's initial centre, the sphere, the emitter and the leveling tools
+// follow it along x (the grade is the scene's rotated gravity, so x is along the slope). The floor
+// and side walls reach over the whole travel and their material does not move, which to the soil
+// is the same as a box that follows; only the bin's end walls are left behind.
+//
+// The emitter lays the soil down again as the prepared bed was: it holds a template, the
+// particles of a slice of the bed (positions and plastic deformation, so the consolidation-
+// dependent adhesion comes back with them) taken after the preparation, and fills copies of it
+// ahead of the bed's front one layer (one particle diameter along x) at a time, each re-emitted
+// particle at a random free site of the layer being filled (a seeded generator: runs repeat bit
+// for bit). A random point of a plane emitter would drop loose soil that the wheels then meet
+// less dense than the consolidated bed; the template gives the bed's density and surface by
+// construction, and the patch checks both ahead of the front wheels against the initial bed.
+// Template sites that would overlap soil already there (at the seams between copies) are
+// skipped. A particle that strays into the emitter's zone (thrown ahead, or pushed by the plate)
+// is re-emitted like one that left the sphere.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "dem_mobility/core/terrain/dem_soil.h"
+
+namespace dem_mobility::core {
+
+/// The soil in a window: bulk density of its lower three quarters and the mean top of its
+/// columns.
+struct PatchSoilMeasure {
+  double density = std::numeric_limits<double>::quiet_NaN();  ///< [kg/m^3]
+  double surface = std::numeric_limits<double>::quiet_NaN();  ///< [m] (scene z)
+  int particles = 0;
+  double reemitted_fraction = 0.0;  ///< of the particles counted: re-emitted ones
+};
+
+/// What the patch has done so far.
+struct PatchStats {
+  long reemitted = 0;             ///< particles re-emitted (left the sphere or strayed)
+  long strays = 0;                ///< of those, strays from the emitter's zone
+  long skipped_sites = 0;         ///< template sites skipped at seams
+  int copies = 0;                 ///< template copies begun
+  bool following = false;
+  PatchSoilMeasure initial;       ///< the bed ahead of the front wheels at the start
+  // the checks with at least 90 % re-emitted soil in the window
+  int checks = 0;
+  double density_ratio_mean = std::numeric_limits<double>::quiet_NaN();  ///< re-emitted / initial
+  double density_ratio_min = std::numeric_limits<double>::quiet_NaN(), density_ratio_max = std::numeric_limits<double>::quiet_NaN();
+  double surface_offset_mean = std::numeric_limits<double>::quiet_NaN(); ///< [m] re-emitted - initial
+  double surface_offset_max = std::numeric_limits<double>::quiet_NaN();  ///< largest |offset| [m]
+};
+
+class SoilPatch {
+ public:
+  /// Over a prepared bin whose patch is enabled: takes the template and sets the sphere.
+  SoilPatch(DemSoilBin* bin, const SoilPatchParams& p, unsigned seed);
+  /// A copy bound to `bin` (a copy of the original's bin).
+  SoilPatch(const SoilPatch& o, DemSoilBin* bin);
+  /// Before each DEM step, with the wheel centres at the end of that step: follows, moves the
+  /// tools, re-emits what left, and checks the soil ahead every check period. SimulationError when
+  /// the patch runs off the end of its floor.
+  void BeforeStep(const std::vector<Eigen::Vector3d>& wheel_centres);
+
+  const PatchStats& stats() const { return stats_; }
+  Eigen::Vector3d sphere_centre() const { return centre_; }
+  double sphere_radius() const { return radius_; }
+  /// The box that follows (for display): its rear and front x, the floor's z, width and height.
+  double box_rear() const { return centre_.x() - 0.5 * bed_length_; }
+  double box_front() const { return centre_.x() + 0.5 * bed_length_; }
+  double floor_z() const { return floor_z_; }
+  double initial_surface() const { return surface0_; }
+  /// The emitter's zone: the layer being filled spans [emitter_from, emitter_to] along x.
+  double emitter_from() const;
+  double emitter_to() const;
+  /// The soil in [x0, x1) (|y| within the side walls less 1.5 d).
+  PatchSoilMeasure Measure(double x0, double x1) const;
+  int initial_particles() const { return n0_; }
+
+ private:
+  struct Site {
+    Eigen::Vector3d x;  ///< relative to the copy's origin (x) and the scene (y, z)
+    double plastic;
+  };
+  void StartCopy();
+  void NextLayer();
+  void Emit();
+  void Check(double front_wheels_x);
+  void PlaceTools(double velocity);
+
+  DemSoilBin* bin_;
+  SoilPatchParams p_;
+  std::mt19937_64 rng_;
+  double d_ = 0.0, bed_length_ = 0.0, width_ = 0.0, floor_z_ = 0.0, surface0_ = 0.0, depth0_ = 0.0;
+  double front_x0_ = 0.0, template_length_ = 0.0, min_site_x_ = 0.0;
+  Eigen::Vector3d centre0_ = Eigen::Vector3d::Zero(), centre_ = Eigen::Vector3d::Zero();
+  double radius_ = 0.0;
+  int n0_ = 0;
+  std::vector<Site> sites_;          ///< sorted by x
+  std::vector<int> layer_begin_;     ///< sites_ index of each layer's first site (+ end)
+  double copy_origin_ = 0.0;         ///< x of the copy being filled
+  int layer_ = -1;                   ///< the layer being filled
+  std::vector<int> free_;            ///< its free sites
+  std::vector<char> skip_;           ///< per site of the copy being filled: skipped at the seam
+  int prev_layer_first_id_ = 0, layer_first_id_ = 0;
+  bool started_ = false;
+  double tool_offset_ = 0.0;         ///< leveling cylinder x - sphere centre x
+  double front_offset_ = 0.0;        ///< front wheels' x - wheel centroid x (at the start)
+  long steps_ = 0, check_every_ = 1;
+  double ratio_sum_ = 0.0, offset_sum_ = 0.0;
+  PatchStats stats_;
+};
+
+}  // namespace dem_mobility::core

@@ -1,0 +1,270 @@
+#include "dem_mobility/core/terrain/soil_patch.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/yaml_reader.h"
+
+namespace dem_mobility::core {
+
+using Eigen::Vector3d;
+
+SoilPatchParams SoilPatchParams::Read(const YamlReader& y) {
+  SoilPatchParams p;
+  p.enabled = true;
+  p.travel = y.DoubleIn("travel", 1.0, 1e5, p.travel);
+  p.sphere_margin = y.DoubleIn("sphere_margin", 0.0, 10.0, p.sphere_margin);
+  p.template_length = y.DoubleIn("template_length", 0.2, 100.0, p.template_length);
+  p.seam_clearance = y.DoubleIn("seam_clearance", 0.5, 1.0, p.seam_clearance);
+  if (y.Has("leveling")) {
+    const YamlReader l = y.Child("leveling");
+    p.leveling_ahead = l.DoubleIn("ahead", 0.0, 50.0, p.leveling_ahead);
+    p.leveling_radius = l.DoubleIn("radius", 0.01, 1.0, p.leveling_radius);
+    p.plate_length = l.DoubleIn("plate_length", 0.01, 10.0, p.plate_length);
+    p.leveling_clearance = l.DoubleIn("clearance", 0.0, 10.0, p.leveling_clearance);
+    l.Finish();
+  }
+  if (y.Has("check_window")) {
+    const std::vector<double> w = y.DoubleList("check_window");
+    if (w.size() != 2 || !(w[0] >= 0.0 && w[1] > w[0] && w[1] <= 50.0))
+      y.Fail("check_window", "expected [from, to] in m ahead of the front wheels' centres, 0 <= from < to <= 50");
+    p.check_from = w[0];
+    p.check_to = w[1];
+  }
+  p.check_period = y.DoubleIn("check_period", 1e-4, 10.0, p.check_period);
+  y.Finish();
+  if (p.check_to > p.leveling_ahead - p.plate_length)
+    y.Fail("check_window", detail::Concat("ends at ", p.check_to, " m, under the leveling plate (from ",
+                                          p.leveling_ahead - p.plate_length, " m ahead of the front wheels)"));
+  return p;
+}
+
+SoilPatch::SoilPatch(DemSoilBin* bin, const SoilPatchParams& p, unsigned seed)
+    : bin_(bin), p_(p), rng_(0x5eed0000ULL + seed) {
+  DM_THROW_UNLESS(p.enabled && bin->prepared() && bin->leveling_plate() >= 0, "SoilPatch: the bin has no patch or is not prepared");
+  const DemSoilParams& bp = bin->params();
+  const DemSystem& dem = bin->dem();
+  d_ = bp.level.particle_diameter;
+  bed_length_ = bp.level.length;
+  width_ = bp.level.width;
+  floor_z_ = bin->floor_z();
+  const double rear = bp.origin.x();
+  front_x0_ = rear + bed_length_;
+  n0_ = dem.size();
+  // the bed's surface and depth, away from the end walls
+  depth0_ = 1.0;  // (Measure's density layer needs a depth; the surface does not)
+  const PatchSoilMeasure bed = Measure(rear + std::min(0.5, 0.1 * bed_length_), front_x0_ - std::min(0.5, 0.1 * bed_length_));
+  DM_THROW_UNLESS(std::isfinite(bed.surface) && bed.surface > floor_z_ + d_, "SoilPatch: the bed has no surface");
+  surface0_ = bed.surface;
+  depth0_ = surface0_ - floor_z_;
+  // the sphere holds the whole bed: nothing leaves before the patch moves
+  centre0_ = Vector3d(rear + 0.5 * bed_length_, 0.0, floor_z_ + 0.5 * depth0_);
+  centre_ = centre0_;
+  radius_ = std::sqrt(0.25 * bed_length_ * bed_length_ + 0.25 * width_ * width_ +
+                      std::pow(0.5 * depth0_ + d_, 2)) + p.sphere_margin;
+  // the template: a slice of the bed's middle
+  template_length_ = std::min(p.template_length, bed_length_ / 3.0);
+  const double xa = centre0_.x() - 0.5 * template_length_;
+  dem.ForEachParticle([&](int id, const Vector3d& x, const Vector3d&) {
+    if (x.x() >= xa && x.x() < xa + template_length_)
+      sites_.push_back({Vector3d(x.x() - xa, x.y(), x.z()), dem.plastic_deformation(id)});
+  });
+  DM_THROW_UNLESS(!sites_.empty(), "SoilPatch: no particles in the template slice");
+  std::sort(sites_.begin(), sites_.end(), [](const Site& a, const Site& b) {
+    if (a.x.x() != b.x.x()) return a.x.x() < b.x.x();
+    if (a.x.y() != b.x.y()) return a.x.y() < b.x.y();
+    return a.x.z() < b.x.z();
+  });
+  min_site_x_ = sites_.front().x.x();
+  for (size_t i = 0; i < sites_.size(); ++i) {
+    const int layer = static_cast<int>(std::floor((sites_[i].x.x() - min_site_x_) / d_));
+    while (static_cast<int>(layer_begin_.size()) <= layer) layer_begin_.push_back(static_cast<int>(i));
+  }
+  layer_begin_.push_back(static_cast<int>(sites_.size()));
+  prev_layer_first_id_ = layer_first_id_ = n0_;
+}
+
+SoilPatch::SoilPatch(const SoilPatch& o, DemSoilBin* bin) : SoilPatch(o) { bin_ = bin; }
+
+double SoilPatch::emitter_from() const {
+  return layer_ < 0 ? front_x0_ : copy_origin_ + min_site_x_ + layer_ * d_;
+}
+double SoilPatch::emitter_to() const { return layer_ < 0 ? front_x0_ : emitter_from() + d_; }
+
+PatchSoilMeasure SoilPatch::Measure(double x0, double x1) const {
+  PatchSoilMeasure m;
+  const DemSystem& dem = bin_->dem();
+  const double ymax = 0.5 * width_ - 1.5 * d_, cell = 2.0 * d_;
+  const int nx = std::max(1, static_cast<int>(std::floor((x1 - x0) / cell)));
+  const int ny = std::max(1, static_cast<int>(std::floor(2.0 * ymax / cell)));
+  const double cx = (x1 - x0) / nx, cy = 2.0 * ymax / ny;
+  std::vector<double> top(static_cast<size_t>(nx) * ny, -std::numeric_limits<double>::infinity());
+  const double z_layer = floor_z_ + 0.75 * depth0_;
+  int counted = 0, reemitted = 0;
+  dem.ForEachParticle([&](int id, const Vector3d& x, const Vector3d&) {
+    if (!(x.x() >= x0 && x.x() < x1 && std::abs(x.y()) < ymax)) return;
+    const int ix = std::min(nx - 1, static_cast<int>((x.x() - x0) / cx));
+    const int iy = std::min(ny - 1, static_cast<int>((x.y() + ymax) / cy));
+    double& t = top[static_cast<size_t>(ix) * ny + iy];
+    t = std::max(t, x.z());
+    if (x.z() < z_layer) ++counted;
+    ++m.particles;
+    if (id >= n0_) ++reemitted;
+  });
+  double sum = 0.0;
+  int columns = 0;
+  for (double t : top)
+    if (std::isfinite(t)) {
+      sum += t + 0.5 * d_;
+      ++columns;
+    }
+  if (columns > 0) m.surface = sum / columns;
+  m.density = counted * dem.mass() / ((x1 - x0) * 2.0 * ymax * 0.75 * depth0_);
+  m.reemitted_fraction = m.particles > 0 ? static_cast<double>(reemitted) / m.particles : 0.0;
+  return m;
+}
+
+void SoilPatch::StartCopy() {
+  const DemSystem& dem = bin_->dem();
+  if (stats_.copies == 0) {
+    // the first copy just ahead of the bed's front
+    double front = -std::numeric_limits<double>::infinity();
+    dem.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
+      if (x.x() < front_x0_ + 2.0 * d_) front = std::max(front, x.x());
+    });
+    copy_origin_ = std::max(front, front_x0_ - 0.5 * d_) + 0.8 * d_ - min_site_x_;
+  } else {
+    copy_origin_ += template_length_;
+  }
+  ++stats_.copies;
+  // skip the sites of the first two layers that would overlap soil already there
+  skip_.assign(sites_.size(), 0);
+  const int end = layer_begin_[std::min<int>(2, static_cast<int>(layer_begin_.size()) - 1)];
+  const double x_lo = copy_origin_ + min_site_x_ - 1.5 * d_, x_hi = copy_origin_ + min_site_x_ + 3.0 * d_;
+  std::vector<Vector3d> near;
+  dem.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
+    if (x.x() > x_lo && x.x() < x_hi) near.push_back(x);
+  });
+  const double c2 = std::pow(p_.seam_clearance * d_, 2);
+  for (int i = 0; i < end; ++i) {
+    const Vector3d s(copy_origin_ + sites_[i].x.x(), sites_[i].x.y(), sites_[i].x.z());
+    for (const Vector3d& x : near)
+      if ((x - s).squaredNorm() < c2) {
+        skip_[i] = 1;
+        ++stats_.skipped_sites;
+        break;
+      }
+  }
+}
+
+void SoilPatch::NextLayer() {
+  const int layers = static_cast<int>(layer_begin_.size()) - 1;
+  do {
+    ++layer_;
+    if (layer_ < 0 || layer_ >= layers || stats_.copies == 0) {
+      StartCopy();
+      layer_ = 0;
+    }
+    free_.clear();
+    for (int i = layer_begin_[layer_]; i < layer_begin_[layer_ + 1]; ++i)
+      if (!skip_[i]) free_.push_back(i);
+  } while (free_.empty());
+  prev_layer_first_id_ = layer_first_id_;
+  layer_first_id_ = bin_->dem().size();
+}
+
+void SoilPatch::Emit() {
+  if (free_.empty()) NextLayer();
+  const size_t k = static_cast<size_t>(rng_() % free_.size());
+  const Site& s = sites_[free_[k]];
+  free_[k] = free_.back();
+  free_.pop_back();
+  DemSystem& dem = bin_->dem();
+  const int id = dem.AddParticle(Vector3d(copy_origin_ + s.x.x(), s.x.y(), s.x.z()));
+  dem.set_plastic_deformation(id, s.plastic);
+  ++stats_.reemitted;
+}
+
+void SoilPatch::PlaceTools(double velocity) {
+  DemSystem& dem = bin_->dem();
+  const double x = centre_.x() + tool_offset_;
+  const double z = surface0_ + p_.leveling_clearance * d_;
+  DemWall& c = dem.mutable_wall(bin_->leveling_cylinder());
+  c.position = Vector3d(x, 0.0, z + p_.leveling_radius);
+  c.velocity = Vector3d(velocity, 0.0, 0.0);
+  c.wrench_point = c.position;
+  DemWall& pl = dem.mutable_wall(bin_->leveling_plate());
+  pl.position = Vector3d(x - p_.plate_length, 0.0, z);
+  pl.velocity = Vector3d(velocity, 0.0, 0.0);
+  pl.wrench_point = pl.position;
+}
+
+void SoilPatch::Check(double front_wheels_x) {
+  const PatchSoilMeasure m = Measure(front_wheels_x + p_.check_from, front_wheels_x + p_.check_to);
+  if (m.particles == 0 || m.reemitted_fraction < 0.9) return;
+  const double ratio = m.density / stats_.initial.density, offset = m.surface - stats_.initial.surface;
+  ++stats_.checks;
+  ratio_sum_ += ratio;
+  offset_sum_ += offset;
+  stats_.density_ratio_mean = ratio_sum_ / stats_.checks;
+  stats_.surface_offset_mean = offset_sum_ / stats_.checks;
+  stats_.density_ratio_min = stats_.checks == 1 ? ratio : std::min(stats_.density_ratio_min, ratio);
+  stats_.density_ratio_max = stats_.checks == 1 ? ratio : std::max(stats_.density_ratio_max, ratio);
+  stats_.surface_offset_max = stats_.checks == 1 ? std::abs(offset) : std::max(stats_.surface_offset_max, std::abs(offset));
+}
+
+void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
+  DM_THROW_UNLESS(wheels.size() >= 2, "SoilPatch: ", wheels.size(), " wheels");
+  DemSystem& dem = bin_->dem();
+  const double dt = dem.dt();
+  double centroid = 0.0;
+  for (const Vector3d& w : wheels) centroid += w.x();
+  centroid /= wheels.size();
+  const double front = 0.5 * (wheels[0].x() + wheels[1].x());
+  if (!started_) {
+    started_ = true;
+    tool_offset_ = front + p_.leveling_ahead - centre0_.x();
+    stats_.initial = Measure(front + p_.check_from, front + p_.check_to);
+    check_every_ = std::max(1L, std::lround(p_.check_period / dt));
+    PlaceTools(0.0);
+  }
+  if (!stats_.following && centroid >= centre0_.x()) {
+    stats_.following = true;
+    // the bin's front wall goes: the emitter lays the soil down beyond it from now on
+    DemWall& fw = dem.mutable_wall(bin_->container_walls()[2]);
+    fw.position.z() += 1000.0;
+  }
+  if (stats_.following) {
+    const double x = std::max(centre_.x(), centroid);
+    const double v = (x - centre_.x()) / dt;
+    centre_.x() = x;
+    PlaceTools(v);
+    if (std::max(box_front(), emitter_to()) > front_x0_ + p_.travel - 2.0 * d_)
+      throw SimulationError(detail::Concat("dem_soil patch (", bin_->params().file, "): the patch reached x = ",
+                                           box_front(), " m, the end of its floor (patch.travel = ", p_.travel,
+                                           " m beyond the bin's front at ", front_x0_, " m)"));
+  }
+  // what left the sphere, and strays in the emitter's zone, in storage order (the same for any
+  // thread count)
+  std::vector<int> out;
+  const double r2 = radius_ * radius_;
+  const bool emitting = layer_ >= 0;
+  const double zone_from = emitter_from() - 0.25 * d_, zone_to = emitter_to() + d_;
+  dem.ForEachParticle([&](int id, const Vector3d& x, const Vector3d&) {
+    if ((x - centre_).squaredNorm() > r2) {
+      out.push_back(id);
+    } else if (stats_.following) {
+      if (x.x() > zone_to || (emitting && x.x() >= zone_from && id < prev_layer_first_id_)) {
+        out.push_back(id);
+        ++stats_.strays;
+      }
+    }
+  });
+  for (int id : out) dem.RemoveParticle(id);
+  for (size_t k = 0; k < out.size(); ++k) Emit();
+  ++steps_;
+  if (steps_ % check_every_ == 0) Check(front);
+}
+
+}  // namespace dem_mobility::core
