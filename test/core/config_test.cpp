@@ -111,6 +111,22 @@ TEST(Config, WrongTypeNamesTheValue) {
   EXPECT_NE(e.find("driveline.yaml: final_drive_ratio: expected a number, found 'fast'"), std::string::npos) << e;
 }
 
+TEST(Config, DifferentialIsOpenOrLocked) {
+  VehicleCopy centre;
+  centre.Edit("driveline.yaml", "centre_differential: locked", "centre_differential: welded");
+  std::string e = centre.Error();
+  EXPECT_NE(e.find("driveline.yaml: centre_differential: must be open or locked, not 'welded'"), std::string::npos)
+      << e;
+  VehicleCopy axles;
+  axles.Edit("driveline.yaml", "axle_differentials: open", "axle_differentials: 1");
+  e = axles.Error();
+  EXPECT_NE(e.find("driveline.yaml: axle_differentials: must be open or locked, not '1'"), std::string::npos) << e;
+  VehicleCopy missing;
+  missing.Edit("driveline.yaml", "centre_differential: locked", "");
+  e = missing.Error();
+  EXPECT_NE(e.find("driveline.yaml: centre_differential: missing required key"), std::string::npos) << e;
+}
+
 TEST(Config, WheelbaseDiffersFromTheSuspensions) {
   VehicleCopy c;
   c.Edit("vehicle.yaml", "wheelbase: 3.378", "wheelbase: 3.0");

@@ -48,9 +48,11 @@ class VehicleAssembler {
   void Corner(int axle, int side);
   /// The rack between the front tie rods' inner ends, sliding along y in the chassis.
   void Steering();
-  /// Pinion, carrier (final drive), open differential, side gears, half shafts with CV joints.
+  /// Pinion, carrier (final drive), differential (open or locked), side gears, half shafts with
+  /// CV joints.
   void Axle(int axle);
-  /// The drive shaft between the pinions (carrier of the centre differential) and the drive torque.
+  /// The drive shaft between the pinions, driving both (centre locked) or the carrier of an open
+  /// centre differential between them, and the drive torque.
   void DriveShaft();
 
  private:
@@ -277,9 +279,15 @@ void VehicleAssembler::Axle(int axle) {
   Revolute("carrier_bearing_" + axle_name, chassis, carrier, centre, Vector3d::UnitY(), 0.05);
   Coupling("final_drive_" + axle_name, chassis,
            {{carrier, Vector3d::UnitY(), 1.0}, {pinion, Vector3d::UnitX(), -driveline.final_drive_ratio}});
-  Coupling("differential_" + axle_name, chassis,
-           {{side_gear[0], Vector3d::UnitY(), 1.0}, {side_gear[1], Vector3d::UnitY(), 1.0},
-            {carrier, Vector3d::UnitY(), -2.0}});
+  if (driveline.axle_differentials == Differential::kOpen) {
+    Coupling("differential_" + axle_name, chassis,
+             {{side_gear[0], Vector3d::UnitY(), 1.0}, {side_gear[1], Vector3d::UnitY(), 1.0},
+              {carrier, Vector3d::UnitY(), -2.0}});
+  } else {  // locked: each side gear turns with the carrier
+    for (int side = 0; side < 2; ++side)
+      Coupling("differential_lock_" + axle_name + "_" + kSide[side], chassis,
+               {{side_gear[side], Vector3d::UnitY(), 1.0}, {carrier, Vector3d::UnitY(), -1.0}});
+  }
   for (int side = 0; side < 2; ++side) {
     const int corner = axle * 2 + side;
     const double s = side == 0 ? 1.0 : -1.0;
@@ -298,10 +306,16 @@ void VehicleAssembler::DriveShaft() {
   const Vector3d front = system_.body(pinion_[0]).x - origin_, rear = system_.body(pinion_[1]).x - origin_;
   const int shaft = Rod("drive_shaft", spec_.driveline.drive_shaft, front, rear);
   Revolute("drive_shaft_bearing", chassis, shaft, 0.5 * (front + rear), Vector3d::UnitX(), 0.4 * (front - rear).norm());
-  Coupling("centre_differential", chassis,
-           {{pinion_[0], Vector3d::UnitX(), 1.0},
-            {pinion_[1], Vector3d::UnitX(), 1.0},
-            {shaft, Vector3d::UnitX(), -2.0}});
+  if (spec_.driveline.centre_differential == Differential::kOpen) {
+    Coupling("centre_differential", chassis,
+             {{pinion_[0], Vector3d::UnitX(), 1.0},
+              {pinion_[1], Vector3d::UnitX(), 1.0},
+              {shaft, Vector3d::UnitX(), -2.0}});
+  } else {  // locked (the paper's): the shaft drives each pinion directly
+    for (int axle = 0; axle < 2; ++axle)
+      Coupling(std::string("drive_shaft_") + kAxle[axle] + "_pinion", chassis,
+               {{pinion_[axle], Vector3d::UnitX(), 1.0}, {shaft, Vector3d::UnitX(), -1.0}});
+  }
   AxisTorque drive;
   drive.name = "drive_torque";
   drive.housing = chassis;

@@ -1,6 +1,7 @@
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 #include <cmath>
+#include <string>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
@@ -48,8 +49,17 @@ RodSpec ReadRod(const YamlReader& y) {
 
 TireGeometry ReadTire(const YamlReader& tire) { return TireGeometry::Read(tire); }
 
+Differential ReadDifferential(const YamlReader& y, const std::string& key) {
+  const std::string mode = y.String(key);
+  if (mode == "open") return Differential::kOpen;
+  if (mode == "locked") return Differential::kLocked;
+  y.Fail(key, "must be open or locked, not '" + mode + "'");
+}
+
 DrivelineSpec ReadDriveline(const YamlReader& driveline) {
   DrivelineSpec d;
+  d.centre_differential = ReadDifferential(driveline, "centre_differential");
+  d.axle_differentials = ReadDifferential(driveline, "axle_differentials");
   d.final_drive_ratio = driveline.DoubleIn("final_drive_ratio", 1e-3, 10.0);
   d.drive_shaft = ReadRod(driveline.Child("drive_shaft"));
   const YamlReader pinion = driveline.Child("pinion");

@@ -67,9 +67,16 @@ struct SteeringSpec {
   Penalty spin_lock;             ///< holds the rack's spin about its own axis
 };
 
-/// Drive shaft (carrier of the centre differential) and per axle pinion, carrier, two side gears
-/// and two half shafts.
+/// How a differential joins its outputs: `kOpen` (carrier speed = mean of the two output speeds,
+/// equal torque split) or `kLocked` (each output turns with the carrier, any torque split).
+enum class Differential { kOpen, kLocked };
+
+/// Drive shaft and per axle pinion, carrier, two side gears and two half shafts. The drive shaft
+/// drives both pinions directly (centre locked, the paper's) or is the carrier of an open centre
+/// differential between them.
 struct DrivelineSpec {
+  Differential centre_differential = Differential::kLocked;  ///< between the front and rear pinions
+  Differential axle_differentials = Differential::kOpen;     ///< between the side gears of each axle
   double final_drive_ratio = 0.0;  ///< carrier speed / pinion speed
   RodSpec drive_shaft;
   MassProperties pinion;
