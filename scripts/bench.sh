@@ -6,14 +6,17 @@
 #   ./scripts/bench.sh road_scene       the 40 s road run end to end through ROS, with the bag
 #   ./scripts/bench.sh dem_step         the DEM solver on the LAMMPS reference bed, beside Debian's lammps
 #   ./scripts/bench.sh wheel_soil       the single-wheel rig's DEM step, beside the same soil without the tire
+#   ./scripts/bench.sh soil_scene       the vehicle on the moving soil patch per level: wall s per simulated s,
+#                                       and the coupled step's rate against the bare soil patch
+#                                       (levels: DM_SOIL_LEVELS, default tiny,coarse; paper takes hours to prepare)
 source "$(dirname "$0")/lib.sh"
 want="${1:-all}"
-case "$want" in all|vehicle_step|cosim_exchange|road_scene|dem_step|wheel_soil) ;; *)
-  echo "unknown benchmark '$want' (have: vehicle_step cosim_exchange road_scene dem_step wheel_soil)" >&2; exit 2 ;;
+case "$want" in all|vehicle_step|cosim_exchange|road_scene|dem_step|wheel_soil|soil_scene) ;; *)
+  echo "unknown benchmark '$want' (have: vehicle_step cosim_exchange road_scene dem_step wheel_soil soil_scene)" >&2; exit 2 ;;
 esac
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}"
 build_core >/dev/null
-if [ "$want" != vehicle_step ] && [ "$want" != dem_step ] && [ "$want" != wheel_soil ]; then build_catkin >/dev/null; ros_env; fi
+if [ "$want" != vehicle_step ] && [ "$want" != dem_step ] && [ "$want" != wheel_soil ] && [ "$want" != soil_scene ]; then build_catkin >/dev/null; ros_env; fi
 echo "# $(date -u +%Y-%m-%dT%H:%MZ) $(uname -m) $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
@@ -86,4 +89,11 @@ if [ "$want" = all ] || [ "$want" = wheel_soil ]; then
   # the coarse rig (6 cm particles, 4 x 1 m bin, f 1.5) rolling at 20 % slip, 2000 timed steps
   "$DM_BUILD/core/bench/wheel_soil_bench" "$DM_ROOT/config/scenes/single_wheel.yaml" 2000 fidelity=coarse \
     cohesion_factor=1.5 wheel.drive=slip wheel.slip=0.2 threads=1
+fi
+
+if [ "$want" = all ] || [ "$want" = soil_scene ]; then
+  # the vehicle on the patch at 12 deg, CI 100, driving; a 0.05 s window per level after the
+  # preparation, settling and 0.2 s of driving; the soil at the scene's threads (2)
+  "$DM_BUILD/core/bench/soil_scene_bench" "$DM_ROOT/config/scenes/soil_slope.yaml" "${DM_SOIL_LEVELS:-tiny,coarse}" \
+    "${DM_SOIL_WINDOW:-0.05}" grade_deg=12 terrain_overrides.cone_index=100
 fi

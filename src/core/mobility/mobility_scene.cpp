@@ -6,7 +6,16 @@ namespace dem_mobility::core {
 
 MobilityRun::MobilityRun(const MobilityRunParams& p)
     : spec_(VehicleSpec::Load(p.vehicle_file)),
-      terrain_(LoadTerrainModel(p.terrain_file, TerrainVehicle{spec_.tire, kWheels}, p.terrain_overrides)),
+      terrain_(LoadTerrainModel(p.terrain_file, TerrainVehicleOf(spec_), p.terrain_overrides)),
+      port_(*terrain_),
+      driver_(p.driver, spec_),
+      sim_(p, spec_) {
+  sim_.Start(port_);
+}
+
+MobilityRun::MobilityRun(const MobilityRunParams& p, std::unique_ptr<TerrainModel> terrain)
+    : spec_(VehicleSpec::Load(p.vehicle_file)),
+      terrain_(std::move(terrain)),
       port_(*terrain_),
       driver_(p.driver, spec_),
       sim_(p, spec_) {

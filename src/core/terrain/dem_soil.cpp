@@ -29,6 +29,8 @@ SoilBinLevel ReadBinLevel(const YamlReader& y, const std::string& name) {
   l.time_step = y.DoubleIn("time_step", 1e-8, 1e-3);
   l.settle_time = y.DoubleIn("settle_time", 0.0, 100.0);
   l.hold_time = y.DoubleIn("hold_time", 0.0, 100.0);
+  if (y.Has("speed_error")) l.speed_error = y.DoubleIn("speed_error", 0.0, 100.0);
+  if (y.Has("speed_error_note")) l.speed_error_note = y.String("speed_error_note");
   y.Finish();
   if (l.soil_depth < 3.0 * l.particle_diameter)
     y.Fail("soil_depth", "must be at least three particle diameters (" + detail::Concat(3.0 * l.particle_diameter) + " m)");
@@ -303,6 +305,17 @@ DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire,
   prepare_wall_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+DemSoilTerrain::DemSoilTerrain(const DemSoilTerrain& o)
+    : TerrainModel(),
+      bin_(std::make_unique<DemSoilBin>(*o.bin_)),
+      patch_(o.patch_ ? std::make_unique<SoilPatch>(*o.patch_, bin_.get()) : nullptr),
+      prepare_wall_(o.prepare_wall_),
+      advance_wall_(o.advance_wall_),
+      description_(o.description_),
+      surface_mesh_(o.surface_mesh_),
+      states_(o.states_),
+      wrenches_(o.wrenches_) {}
+
 DemSoilTerrain::~DemSoilTerrain() = default;
 
 TerrainDisplay DemSoilTerrain::Display() const {
@@ -326,6 +339,11 @@ TerrainDisplay DemSoilTerrain::Display() const {
 void DemSoilTerrain::Describe(ResultFile* r) const {
   const DemSoilParams& p = bin_->params();
   p.Describe(r);
+  if (std::isfinite(p.level.speed_error))
+    r->Set("speed_error_estimate", p.level.speed_error);
+  else
+    r->Set("speed_error_estimate", std::string("not measured for level '") + p.level.name + "'");
+  if (!p.level.speed_error_note.empty()) r->Set("speed_error_note", p.level.speed_error_note);
   r->Set("soil_time_step", p.level.time_step);
   r->Set("particles", bin_->dem().num_alive());
   r->Set("soil_depth", bin_->surface_height() - bin_->floor_z());
@@ -413,6 +431,12 @@ std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const Terr
   const DemSoilParams p = DemSoilParams::Read(y);
   y.String("model");
   y.Finish();
+  const SoilBinLevel& l = p.level;
+  const double needed = vehicle.track + vehicle.tire.width + 2.0 * l.particle_diameter;
+  if (vehicle.wheels > 1 && vehicle.track > 0.0 && needed > l.width)
+    throw ConfigError(detail::Concat(p.file, ": levels.", l.name, ".width: the soil (", l.width,
+                                     " m wide) is narrower than the vehicle's track (", vehicle.track,
+                                     " m) plus a tire width and two particle diameters (", needed, " m)"));
   return std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels);
 }
 

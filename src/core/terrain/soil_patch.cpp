@@ -126,64 +126,72 @@ PatchSoilMeasure SoilPatch::Measure(double x0, double x1) const {
 }
 
 void SoilPatch::StartCopy() {
-  const DemSystem& dem = bin_->dem();
   if (stats_.copies == 0) {
-    // the first copy just ahead of the bed's front
+    // the first copy just ahead of the bed's front (sites too near it are skipped as they come)
     double front = -std::numeric_limits<double>::infinity();
-    dem.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
+    bin_->dem().ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
       if (x.x() < front_x0_ + 2.0 * d_) front = std::max(front, x.x());
     });
-    copy_origin_ = std::max(front, front_x0_ - 0.5 * d_) + 0.8 * d_ - min_site_x_;
+    copy_origin_ = std::max(front, front_x0_ - 0.5 * d_) + 0.4 * d_ - min_site_x_;
   } else {
     copy_origin_ += template_length_;
   }
   ++stats_.copies;
-  // skip the sites of the first two layers that would overlap soil already there
-  skip_.assign(sites_.size(), 0);
-  const int end = layer_begin_[std::min<int>(2, static_cast<int>(layer_begin_.size()) - 1)];
-  const double x_lo = copy_origin_ + min_site_x_ - 1.5 * d_, x_hi = copy_origin_ + min_site_x_ + 3.0 * d_;
-  std::vector<Vector3d> near;
-  dem.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
-    if (x.x() > x_lo && x.x() < x_hi) near.push_back(x);
+}
+
+void SoilPatch::GatherZone() {
+  zone_.clear();
+  const double lo = emitter_from() - 1.5 * d_, hi = emitter_to() + 1.5 * d_;
+  bin_->dem().ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
+    if (x.x() > lo && x.x() < hi) zone_.push_back(x);
   });
-  const double c2 = std::pow(p_.seam_clearance * d_, 2);
-  for (int i = 0; i < end; ++i) {
-    const Vector3d s(copy_origin_ + sites_[i].x.x(), sites_[i].x.y(), sites_[i].x.z());
-    for (const Vector3d& x : near)
-      if ((x - s).squaredNorm() < c2) {
-        skip_[i] = 1;
-        ++stats_.skipped_sites;
-        break;
-      }
-  }
 }
 
 void SoilPatch::NextLayer() {
   const int layers = static_cast<int>(layer_begin_.size()) - 1;
-  do {
-    ++layer_;
-    if (layer_ < 0 || layer_ >= layers || stats_.copies == 0) {
-      StartCopy();
-      layer_ = 0;
-    }
-    free_.clear();
-    for (int i = layer_begin_[layer_]; i < layer_begin_[layer_ + 1]; ++i)
-      if (!skip_[i]) free_.push_back(i);
-  } while (free_.empty());
+  ++layer_;
+  if (stats_.copies == 0 || layer_ >= layers) {
+    StartCopy();
+    layer_ = 0;
+  }
+  // the layer is laid from the bottom up: its free sites by height
+  free_.clear();
+  for (int i = layer_begin_[layer_]; i < layer_begin_[layer_ + 1]; ++i) free_.push_back(i);
+  std::stable_sort(free_.begin(), free_.end(), [&](int a, int b) { return sites_[a].x.z() < sites_[b].x.z(); });
   prev_layer_first_id_ = layer_first_id_;
   layer_first_id_ = bin_->dem().size();
+  GatherZone();
+}
+
+bool SoilPatch::Blocked(const Vector3d& x) const {
+  const double c2 = std::pow(p_.seam_clearance * d_, 2);
+  for (const Vector3d& z : zone_)
+    if ((z - x).squaredNorm() < c2) return true;
+  return false;
 }
 
 void SoilPatch::Emit() {
-  if (free_.empty()) NextLayer();
-  const size_t k = static_cast<size_t>(rng_() % free_.size());
-  const Site& s = sites_[free_[k]];
-  free_[k] = free_.back();
-  free_.pop_back();
-  DemSystem& dem = bin_->dem();
-  const int id = dem.AddParticle(Vector3d(copy_origin_ + s.x.x(), s.x.y(), s.x.z()));
-  dem.set_plastic_deformation(id, s.plastic);
-  ++stats_.reemitted;
+  for (;;) {
+    if (free_.empty()) NextLayer();
+    // a random free site among the lowest ones (within a diameter of the lowest)
+    const double z_low = sites_[free_.front()].x.z();
+    size_t m = 1;
+    while (m < free_.size() && sites_[free_[m]].x.z() < z_low + d_) ++m;
+    const size_t k = static_cast<size_t>(rng_() % m);
+    const Site s = sites_[free_[k]];
+    free_.erase(free_.begin() + static_cast<long>(k));
+    const Vector3d x(copy_origin_ + s.x.x(), s.x.y(), s.x.z());
+    if (Blocked(x)) {  // soil already there (a seam, or a particle that fell or was thrown)
+      ++stats_.skipped_sites;
+      continue;
+    }
+    DemSystem& dem = bin_->dem();
+    const int id = dem.AddParticle(x);
+    dem.set_plastic_deformation(id, s.plastic);
+    zone_.push_back(x);
+    ++stats_.reemitted;
+    return;
+  }
 }
 
 void SoilPatch::PlaceTools(double velocity) {
@@ -251,14 +259,16 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   const double r2 = radius_ * radius_;
   const bool emitting = layer_ >= 0;
   const double zone_from = emitter_from() - 0.25 * d_, zone_to = emitter_to() + d_;
+  const double near_lo = emitter_from() - 1.5 * d_, near_hi = emitter_to() + 1.5 * d_;
+  zone_.clear();
   dem.ForEachParticle([&](int id, const Vector3d& x, const Vector3d&) {
     if ((x - centre_).squaredNorm() > r2) {
       out.push_back(id);
-    } else if (stats_.following) {
-      if (x.x() > zone_to || (emitting && x.x() >= zone_from && id < prev_layer_first_id_)) {
-        out.push_back(id);
-        ++stats_.strays;
-      }
+    } else if (stats_.following && (x.x() > zone_to || (emitting && x.x() >= zone_from && id < prev_layer_first_id_))) {
+      out.push_back(id);
+      ++stats_.strays;
+    } else if (x.x() > near_lo && x.x() < near_hi) {
+      zone_.push_back(x);
     }
   });
   for (int id : out) dem.RemoveParticle(id);

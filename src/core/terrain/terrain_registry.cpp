@@ -1,4 +1,6 @@
 // The registry of terrain kinds: one row per `model:` (the next kinds are added here).
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include "dem_mobility/core/common/registry.h"
@@ -6,6 +8,7 @@
 #include "dem_mobility/core/terrain/dem_soil.h"
 #include "dem_mobility/core/terrain/road_terrain.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 namespace dem_mobility::core {
 
@@ -17,6 +20,15 @@ const std::vector<TerrainKind>& TerrainKinds() {
        [](const YamlReader& y, const TerrainVehicle& v) { return MakeDemSoilTerrain(y, v); }, &DescribeDemSoilTerrain},
   };
   return kinds;
+}
+
+TerrainVehicle TerrainVehicleOf(const VehicleSpec& spec) {
+  TerrainVehicle v;
+  v.tire = spec.tire;
+  v.wheels = kWheels;
+  v.track = 2.0 * std::max(std::abs(spec.suspension_front.hardpoints.spindle.y()),
+                           std::abs(spec.suspension_rear.hardpoints.spindle.y()));
+  return v;
 }
 
 namespace {

@@ -14,6 +14,8 @@ class MobilityRun {
   /// Builds the terrain, the driver and the vehicle, and makes the opening exchange (ConfigError
   /// for bad input or a time step above the limit).
   explicit MobilityRun(const MobilityRunParams& p);
+  /// The same on a terrain built already (e.g. a copy of a prepared soil: one preparation, many runs).
+  MobilityRun(const MobilityRunParams& p, std::unique_ptr<TerrainModel> terrain);
   MobilityRunResult Run(CoSimObserver* observer = nullptr);
   VehicleCoSim& sim() { return sim_; }
   Vehicle& vehicle() { return sim_.vehicle(); }

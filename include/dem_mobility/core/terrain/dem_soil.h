@@ -34,6 +34,10 @@ struct SoilBinLevel {
   double time_step = 8e-5;          ///< [s]
   double settle_time = 0.5;         ///< [s] after the pour
   double hold_time = 0.5;           ///< [s] at the lid pressure
+  /// [m/s] the level's speed-made-good error against the finest level run (the fidelity study,
+  /// docs/vehicle-on-soil.md); NaN: not measured
+  double speed_error = std::numeric_limits<double>::quiet_NaN();
+  std::string speed_error_note;     ///< where that figure comes from
 };
 
 /// The moving soil patch (paper section 4.2, fig. 18): particles that leave a bounding sphere are
@@ -154,7 +158,12 @@ class SoilPatch;
 class DemSoilTerrain final : public TerrainModel {
  public:
   DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels);
+  /// A copy (its own particles, walls and patch): one prepared soil serves several runs.
+  DemSoilTerrain(const DemSoilTerrain& o);
+  DemSoilTerrain& operator=(const DemSoilTerrain&) = delete;
   ~DemSoilTerrain() override;
+  /// OpenMP threads of the soil from the next step on (the results do not depend on it).
+  void set_threads(int threads) { bin_->dem().set_threads(threads); }
   const TerrainDescription& description() const override { return description_; }
   void Synchronize(long step, double t, const std::vector<WheelState>& states) override;
   void GetWrenches(std::vector<WheelWrench>* wrenches) const override;

@@ -11,12 +11,12 @@
 // particles of a slice of the bed (positions and plastic deformation, so the consolidation-
 // dependent adhesion comes back with them) taken after the preparation, and fills copies of it
 // ahead of the bed's front one layer (one particle diameter along x) at a time, each re-emitted
-// particle at a random free site of the layer being filled (a seeded generator: runs repeat bit
-// for bit). A random point of a plane emitter would drop loose soil that the wheels then meet
+// particle at a random free site among the lowest of the layer being filled (the layer is laid
+// from the bottom up; a seeded generator: runs repeat bit for bit). A random point of a plane emitter would drop loose soil that the wheels then meet
 // less dense than the consolidated bed; the template gives the bed's density and surface by
 // construction, and the patch checks both ahead of the front wheels against the initial bed.
-// Template sites that would overlap soil already there (at the seams between copies) are
-// skipped. A particle that strays into the emitter's zone (thrown ahead, or pushed by the plate)
+// Template sites that would overlap soil already there (at the seams between copies, or a
+// particle that fell or was thrown there) are skipped. A particle that strays into the emitter's zone (thrown ahead, or pushed by the plate)
 // is re-emitted like one that left the sphere.
 #pragma once
 
@@ -43,7 +43,7 @@ struct PatchSoilMeasure {
 struct PatchStats {
   long reemitted = 0;             ///< particles re-emitted (left the sphere or strayed)
   long strays = 0;                ///< of those, strays from the emitter's zone
-  long skipped_sites = 0;         ///< template sites skipped at seams
+  long skipped_sites = 0;         ///< template sites skipped: soil already there
   int copies = 0;                 ///< template copies begun
   bool following = false;
   PatchSoilMeasure initial;       ///< the bed ahead of the front wheels at the start
@@ -88,6 +88,9 @@ class SoilPatch {
   };
   void StartCopy();
   void NextLayer();
+  /// The particles near the layer being filled.
+  void GatherZone();
+  bool Blocked(const Eigen::Vector3d& x) const;
   void Emit();
   void Check(double front_wheels_x);
   void PlaceTools(double velocity);
@@ -104,8 +107,8 @@ class SoilPatch {
   std::vector<int> layer_begin_;     ///< sites_ index of each layer's first site (+ end)
   double copy_origin_ = 0.0;         ///< x of the copy being filled
   int layer_ = -1;                   ///< the layer being filled
-  std::vector<int> free_;            ///< its free sites
-  std::vector<char> skip_;           ///< per site of the copy being filled: skipped at the seam
+  std::vector<int> free_;            ///< its free sites, lowest first
+  std::vector<Eigen::Vector3d> zone_;  ///< particles near the layer being filled
   int prev_layer_first_id_ = 0, layer_first_id_ = 0;
   bool started_ = false;
   double tool_offset_ = 0.0;         ///< leveling cylinder x - sphere centre x

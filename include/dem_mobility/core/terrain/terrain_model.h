@@ -59,7 +59,12 @@ class TerrainModel {
 struct TerrainVehicle {
   TireGeometry tire;
   int wheels = 4;
+  double track = 0.0;  ///< [m] between the wheel centres of the wider axle (0: unknown)
 };
+
+struct VehicleSpec;
+/// What a terrain needs of the vehicle `spec` describes (its tire, four wheels, its track).
+TerrainVehicle TerrainVehicleOf(const VehicleSpec& spec);
 
 /// One kind of terrain: the `model:` key of its files, a factory and a describer.
 struct TerrainKind {

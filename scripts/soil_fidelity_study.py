@@ -1,0 +1,185 @@
+#!/usr/bin/env python3
+"""Fidelity study of the vehicle on the moving soil patch (issue 13): runs the soil scene through
+roslaunch (soil_slope.launch, the launch file and nodelets a user runs) for every fidelity level
+and case (grade, cone index), one run at a time by default, and writes into OUT:
+
+  runs/<level>_g<grade>_ci<ci>.bag (+ .result.yaml, .log)   every run
+  study.yaml     per case and level: speed-made-good, status, wall time (preparation included),
+                 simulated time, particles, and the error against the finest level that ran
+  study.md       the same as a Markdown table (docs/vehicle-on-soil.md takes it)
+  study.png      speed-made-good against wall time, one line per case, the finest level marked
+
+    python3 scripts/soil_fidelity_study.py --levels tiny,coarse --cases 12:100,0:50 --out results/soil_fidelity
+
+--runner core runs build/core's dm_run_scene instead of roslaunch: the same core loop in one
+process, without the ROS layer and without a bag (a developer's check, or a study on a machine
+where the ROS build is not wanted). A failed run is reported and the others are kept; the exit
+status is 1 if any run failed.
+"""
+import argparse
+import os
+import sys
+
+import yaml
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import dm_sweep  # noqa: E402
+
+ROOT = os.path.dirname(HERE)
+# particle diameter of each level (config/terrains/soil_patch.yaml), finest first
+LEVEL_ORDER = ['paper', 'fine', 'medium', 'coarse', 'tiny']
+STATUSES = ('steady', 'command_limited', 'no_go', 'not_steady')
+
+
+def parse_cases(text):
+    out = []
+    for item in text.split(','):
+        try:
+            g, ci = item.split(':')
+            out.append((float(g), float(ci)))
+        except ValueError:
+            raise argparse.ArgumentTypeError('expected GRADE:CI pairs separated by commas, got %r' % item)
+    return out
+
+
+def case_name(p):
+    return '%s_g%g_ci%g' % (p['level'], p['grade'], p['ci'])
+
+
+def roslaunch_command(a, case, port):
+    return ['roslaunch', '-p', str(port), 'dem_mobility', 'soil_slope.launch', 'scene:=' + os.path.abspath(a.scene),
+            'fidelity:=' + case['level'], 'grade:=%g' % case['grade'], 'cone_index:=%g' % case['ci'],
+            'dem_threads:=%d' % a.dem_threads, 'duration:=%g' % a.duration, 'cloud_rate:=%g' % a.cloud_rate,
+            'bag:=' + os.path.abspath(os.path.join(a.out, 'runs', case.name + '.bag')), 'rviz:=false', 'end_run:=true']
+
+
+def core_command(a, case, result_file):
+    return [a.dm_run_scene, os.path.abspath(a.scene), 'grade_deg=%g' % case['grade'],
+            'terrain_overrides.fidelity=' + case['level'], 'terrain_overrides.cone_index=%g' % case['ci'],
+            'terrain_overrides.threads=%d' % a.dem_threads, 'duration=%g' % a.duration,
+            '--out', os.path.abspath(result_file),
+            '--history', os.path.abspath(result_file.replace('.result.yaml', '.history.csv'))]
+
+
+def check(case, result):
+    if result.get('kind') != 'soil_slope':
+        return 'the result is of kind %r, not soil_slope' % result.get('kind')
+    if result.get('status') not in STATUSES:
+        return 'status %r' % result.get('status')
+    return None
+
+
+def number(x):
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        return float('nan')
+
+
+def summarize(sweep, cases_gs):
+    """Per case: the levels' figures and their error against the finest level that ran."""
+    rows = []
+    for g, ci in cases_gs:
+        runs = {}
+        for o in sweep.outcomes:
+            if o.case['grade'] == g and o.case['ci'] == ci and o.ok:
+                r = o.result
+                runs[o.case['level']] = {
+                    'speed_made_good': number(r.get('speed_made_good')),
+                    'status': r.get('status'),
+                    'wall_time': number(r.get('wall_time')) + number(r.get('soil_prepare_wall_time') or 0.0),
+                    'run_wall_time': number(r.get('wall_time')),
+                    'prepare_wall_time': number(r.get('soil_prepare_wall_time')),
+                    'simulated_time': number(r.get('simulated_time')),
+                    'particles': int(number(r.get('particles'))),
+                    'particle_diameter': number(r.get('particle_diameter')),
+                    'patch_density_ratio': number(r.get('patch_density_ratio')),
+                    'cohesion_factor': number(r.get('cohesion_factor')),
+                }
+        finest = next((l for l in LEVEL_ORDER if l in runs), None)
+        for level in LEVEL_ORDER:
+            if level not in runs:
+                continue
+            x = runs[level]
+            x['reference'] = finest
+            x['error_vs_finest'] = abs(x['speed_made_good'] - runs[finest]['speed_made_good'])
+            rows.append(dict(grade=g, cone_index=ci, level=level, **x))
+    return rows
+
+
+def write_table(rows, path):
+    with open(path, 'w') as fh:
+        fh.write('| grade [deg] | CI [psi] | level | d [m] | particles | speed-made-good [m/s] | status | '
+                 '|error| vs finest [m/s] | wall time [s] (preparation) | simulated [s] | re-emitted density ratio |\n')
+        fh.write('|---|---|---|---|---|---|---|---|---|---|---|\n')
+        for r in rows:
+            fh.write('| %g | %g | %s | %g | %d | %.3f | %s | %s | %.0f (%.0f) | %.2f | %.3f |\n' % (
+                r['grade'], r['cone_index'], r['level'], r['particle_diameter'], r['particles'], r['speed_made_good'],
+                r['status'], 'reference' if r['level'] == r['reference'] else '%.3f' % r['error_vs_finest'],
+                r['wall_time'], r['prepare_wall_time'], r['simulated_time'], r['patch_density_ratio']))
+
+
+def plot(rows, path):
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for key in sorted({(r['grade'], r['cone_index']) for r in rows}):
+        rs = [r for r in rows if (r['grade'], r['cone_index']) == key]
+        ax.plot([r['wall_time'] for r in rs], [r['speed_made_good'] for r in rs], 'o-',
+                label='%g deg, CI %g psi' % key)
+        for r in rs:
+            ax.annotate(r['level'] + (' (ref)' if r['level'] == r['reference'] else ''),
+                        (r['wall_time'], r['speed_made_good']), textcoords='offset points', xytext=(5, 5), fontsize=8)
+    ax.set_xscale('log')
+    ax.set_xlabel('wall time of the run, preparation included [s] (2-core machine)')
+    ax.set_ylabel('speed-made-good [m/s]')
+    ax.set_title('Speed-made-good against run time per fidelity level')
+    ax.grid(True, which='both', alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('--scene', default=os.path.join(ROOT, 'config', 'scenes', 'soil_slope.yaml'))
+    ap.add_argument('--levels', default='tiny,coarse', help='fidelity levels (default tiny,coarse)')
+    ap.add_argument('--cases', type=parse_cases, default=parse_cases('12:100,0:50'), help='GRADE:CI pairs')
+    ap.add_argument('--duration', type=float, default=40.0, help='longest driving time [s] (the run ends when steady)')
+    ap.add_argument('--jobs', type=int, default=1)
+    ap.add_argument('--dem-threads', type=int, default=1)
+    ap.add_argument('--cloud-rate', type=float, default=2.0, help='particle clouds per simulated second in each bag')
+    ap.add_argument('--timeout', type=float, default=6 * 3600.0, help='longest a run may take [s]')
+    ap.add_argument('--port', type=int, default=11511)
+    ap.add_argument('--runner', choices=('roslaunch', 'core'), default='roslaunch')
+    ap.add_argument('--dm-run-scene', default=os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene'))
+    ap.add_argument('--resume', action='store_true', help='keep the runs whose result is already good')
+    ap.add_argument('--out', default='results/soil_fidelity')
+    a = ap.parse_args()
+    levels = [l for l in a.levels.split(',') if l]
+    bad = [l for l in levels if l not in LEVEL_ORDER]
+    if bad:
+        ap.error('unknown level(s) %s (have %s)' % (', '.join(bad), ', '.join(LEVEL_ORDER)))
+    params = [dict(level=l, grade=g, ci=ci) for g, ci in a.cases for l in levels]
+    cases = dm_sweep.cases(params, name=case_name)
+    if a.runner == 'core':
+        command = lambda case, o: core_command(a, case, o.result_file)  # noqa: E731
+    else:
+        command = lambda case, o: roslaunch_command(a, case, o.port)  # noqa: E731
+    sweep = dm_sweep.run_sweep(cases, command, os.path.join(a.out, 'runs'), resume=a.resume, jobs=a.jobs,
+                               port=a.port, timeout=a.timeout, check=check, accept_status=STATUSES,
+                               summary=os.path.join(a.out, 'sweep.yaml'))
+    rows = summarize(sweep, a.cases)
+    with open(os.path.join(a.out, 'study.yaml'), 'w') as fh:
+        yaml.safe_dump({'runner': a.runner, 'levels': levels, 'rows': rows}, fh, sort_keys=False)
+    if rows:
+        write_table(rows, os.path.join(a.out, 'study.md'))
+        plot(rows, os.path.join(a.out, 'study.png'))
+        print(open(os.path.join(a.out, 'study.md')).read())
+    return sweep.exit_status()
+
+
+if __name__ == '__main__':
+    sys.exit(main())
