@@ -3,6 +3,7 @@
 // phases.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <limits>
 #include <stdexcept>
@@ -15,6 +16,7 @@
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/cosim/cosim_loop.h"
+#include "dem_mobility/core/mobility/mobility_scene.h"
 #include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/scenes/scene_registry.h"
 #include "dem_mobility/core/scenes/soil_prep.h"
@@ -172,6 +174,54 @@ TEST(SoilPreparation, PhasesInOrderAndZeroDurationsTakeNoStep) {
   EXPECT_NEAR(prep.lid_pressure_reached(), p.lid_pressure, 0.1 * p.lid_pressure);
   EXPECT_EQ(s.wall(l).position.z(), 0.3);
   EXPECT_GT(prep.height_poured(), 0.0);
+}
+
+}  // namespace
+}  // namespace dem_mobility::core
+
+namespace dem_mobility::core {
+namespace {
+
+TEST(SteadyWindow, MeansOverTheWindowAndTheDrawbarMarginBeyondTheGrade) {
+  // a history whose last 2 s hold constant figures and whose earlier samples differ
+  std::vector<MobilitySample> h;
+  for (int k = 0; k <= 500; ++k) {
+    MobilitySample s{0.01 * k, 0.0, 5.0, 5.0, 0.0, 0.0, 0.0, true};
+    const bool window = s.t >= 5.0 - 2.0 - 1e-9;
+    for (int i = 0; i < kWheels; ++i) {
+      s.slip[i] = window ? 0.1 * (i + 1) : 0.9;
+      s.sinkage[i] = window ? 0.01 * (i + 1) : 0.5;
+    }
+    s.traction = window ? 12000.0 : -1.0;
+    s.thrust = window ? 15000.0 : 0.0;
+    h.push_back(s);
+  }
+  const double m = 5000.0, grade = 10.0, wn = m * 9.81 * std::cos(grade * M_PI / 180.0);
+  const SteadyFigures f = SteadyWindowFigures(h, 2.0, m, grade);
+  EXPECT_EQ(f.samples, 201);
+  for (int i = 0; i < kWheels; ++i) {
+    EXPECT_NEAR(f.slip[i], 0.1 * (i + 1), 1e-12);
+    EXPECT_NEAR(f.sinkage[i], 0.01 * (i + 1), 1e-12);
+  }
+  EXPECT_NEAR(f.traction_coefficient, 12000.0 / wn, 1e-12);
+  EXPECT_NEAR(f.motion_resistance, 3000.0 / wn, 1e-12);
+  EXPECT_NEAR(f.drawbar_margin, 12000.0 / wn - std::tan(grade * M_PI / 180.0), 1e-12);
+}
+
+TEST(VehicleCoSim, EndsWhenSteadyIfAskedWithTheSpeedOfTheFullRun) {
+  // the road at 20 deg: WOT-limited at about 13 m/s after ~15 s; asked to end when steady, the
+  // run stops well before its 40 s with the same verdict and speed as the run that goes on
+  MobilityRunParams p = MobilityRunParams::Read(
+      YamlReader::LoadWithOverrides(DM_CONFIG_DIR "/scenes/road_slope.yaml", {"grade_deg=20", "duration=30"}));
+  const MobilityRunResult full = MobilityRun(p).Run();
+  p.end_when_steady = true;
+  const MobilityRunResult early = MobilityRun(p).Run();
+  ASSERT_TRUE(full.error.empty() && early.error.empty()) << full.error << early.error;
+  ASSERT_EQ(full.smg.status, "steady");
+  EXPECT_EQ(early.smg.status, "steady");
+  EXPECT_TRUE(early.ended_early);
+  EXPECT_LT(early.sim_time, 0.9 * full.sim_time);
+  EXPECT_NEAR(early.smg.value, full.smg.value, 0.01 * full.smg.value);
 }
 
 }  // namespace
