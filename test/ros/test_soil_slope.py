@@ -8,7 +8,7 @@ preparation dominates):
   agrees with the YAML;
 - its bag holds the particle clouds (x, y, z, plastic_strain, every 1 / cloud_rate of simulated
   time), the patch tools, the wheel exchanges, the force arrows and speed label; plot_speed.py
-  draws it;
+  draws it, and the topics of rviz/soil_slope.rviz are its topics;
 - the soil on 1 and on 2 threads gives the same bag, message for message (the result message but
   for its wall time);
 - a cone index outside the calibration table is refused naming the terrain file and the key.
@@ -241,6 +241,20 @@ class SoilSlopeRuns(unittest.TestCase):
         self.assertGreater(fz, 25e3)
         self.assertLess(fz, 100e3)
         self.assertTrue(all(n > 0 for w in last for n in w.contacts))
+
+    def test_rviz_view_shows_the_bags_topics(self):
+        with open(os.path.join(ROOT, 'rviz', 'soil_slope.rviz')) as f:
+            displays = yaml.safe_load(f)['Visualization Manager']['Displays']
+        topics = [d.get('Topic') or d.get('Marker Topic') for d in displays]
+        topics = [t for t in topics if t]
+        self.assertIn(NS + 'terrain/particles', topics)
+        self.assertIn(NS + 'terrain/tools', topics)
+        for t in topics:
+            self.assertIn(t, self.msgs, t)
+        fields = {f.name for f in self.msgs[NS + 'terrain/particles'][-1].fields}
+        for d in displays:
+            if d['Class'] == 'rviz/PointCloud2':
+                self.assertIn(d['Channel Name'], fields)
 
     def test_plot_speed_draws_the_soil_bag(self):
         out = os.path.join(self.tmp, 'speed.png')
