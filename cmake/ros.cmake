@@ -14,6 +14,9 @@ add_message_files(DIRECTORY msg FILES
   WheelRigSample.msg
   SingleWheelResult.msg
 )
+add_service_files(DIRECTORY srv FILES
+  TerrainReport.srv
+)
 generate_messages(DEPENDENCIES std_msgs geometry_msgs)
 
 catkin_package(
@@ -30,6 +33,7 @@ if(CATKIN_ENABLE_TESTING)
   find_package(roslaunch REQUIRED)
   # every launch file parses and finds its packages and files
   roslaunch_add_file_check(launch/road_slope.launch)
+  roslaunch_add_file_check(launch/soil_slope.launch)
   roslaunch_add_file_check(launch/cone_penetrometer.launch)
   roslaunch_add_file_check(launch/single_wheel.launch)
   roslaunch_add_file_check(launch/replay.launch bag:=/tmp/run.bag)

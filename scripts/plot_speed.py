@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Speed time history of a run, as in the paper's figures 21/22: the vehicle's speed and the
-driver's speed command against time from the driver's start, with the speed-made-good.
+driver's speed command against time from the driver's start, with the speed-made-good (road and
+soil runs alike: the same odom, driver_command and result topics).
 
     python3 scripts/plot_speed.py RUN.bag [-o RUN.png] [--ns /mobility]
 """
@@ -53,6 +54,9 @@ def main():
     if result is not None:
         title = '%s: grade %.1f deg, speed-made-good %.2f m/s (%s)' % (
             os.path.basename(result.scene), result.grade_deg, result.speed_made_good, result.status)
+        if getattr(result, 'fidelity', ''):  # a DEM soil (bags of older runs have no such field)
+            ci = result.cone_index_psi
+            title += '\nsoil level %s, cone index %s' % (result.fidelity, 'unknown' if ci != ci else '%.0f psi' % ci)
         if result.status in ('steady', 'command_limited'):
             ax.axhline(result.speed_made_good, color='tab:red', lw=0.8, label='speed-made-good')
     ax.set_title(title, fontsize=10)

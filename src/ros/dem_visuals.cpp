@@ -1,5 +1,9 @@
 #include "dem_mobility/ros/dem_visuals.h"
+#include "dem_mobility/core/common/error.h"
 #include "dem_mobility/ros/core_names.h"
+
+#include <cmath>
+#include <limits>
 
 #include <Eigen/Geometry>
 #include <sensor_msgs/point_cloud2_iterator.h>
@@ -33,6 +37,39 @@ void ToPointCloud(const DemSystem& s, sensor_msgs::PointCloud2* cloud,
     *e = static_cast<float>(s.plastic_deformation(id) * inv_d);
     ++x, ++y, ++z, ++e;
   }
+}
+
+void ToPointCloud(const DemSystem& s, std::vector<float>* first_shown, sensor_msgs::PointCloud2* cloud) {
+  const int n = s.num_alive();
+  sensor_msgs::PointCloud2Modifier mod(*cloud);
+  mod.setPointCloud2Fields(5, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1, sensor_msgs::PointField::FLOAT32,
+                           "z", 1, sensor_msgs::PointField::FLOAT32, "plastic_strain", 1,
+                           sensor_msgs::PointField::FLOAT32, "plastic_strain_change", 1,
+                           sensor_msgs::PointField::FLOAT32);
+  mod.resize(n);
+  cloud->height = 1;
+  cloud->width = n;
+  cloud->is_dense = true;
+  sensor_msgs::PointCloud2Iterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
+  sensor_msgs::PointCloud2Iterator<float> e(*cloud, "plastic_strain"), de(*cloud, "plastic_strain_change");
+  const double inv_d = 1.0 / s.soil().diameter;
+  if (static_cast<int>(first_shown->size()) < s.size())
+    first_shown->resize(s.size(), std::numeric_limits<float>::quiet_NaN());
+  int written = 0;
+  for (int id = 0; id < s.size(); ++id) {
+    if (!s.alive(id)) continue;
+    const Eigen::Vector3d p = s.position(id);
+    const float strain = static_cast<float>(s.plastic_deformation(id) * inv_d);
+    float& first = (*first_shown)[id];
+    if (std::isnan(first)) first = strain;
+    *x = static_cast<float>(p.x());
+    *y = static_cast<float>(p.y());
+    *z = static_cast<float>(p.z());
+    *e = strain;
+    *de = strain - first;
+    ++x, ++y, ++z, ++e, ++de, ++written;
+  }
+  DM_THROW_UNLESS(written == n, "ToPointCloud: ", written, " live particles for num_alive() = ", n);
 }
 
 visualization_msgs::Marker WallMarker(const DemWall& w, const std::string& ns, int id, float r, float g, float b,

@@ -1,24 +1,40 @@
 // dem_mobility/TerrainNodelet: the terrain side of the lock-step exchange of a vehicle scene. Builds
-// the scene's terrain model (core, any kind the terrain registry knows), answers each WheelStates
-// with the WheelWrenches of the same step (synchronize, wrenches, advance to the next exchange),
-// and shows the surface in rviz. No physics here: the core computes, the nodelet converts.
+// the scene's terrain model (core, any kind the terrain registry knows, with the scene's
+// terrain_overrides), answers each WheelStates with the WheelWrenches of the same step (synchronize,
+// wrenches, advance to the next exchange), and shows the surface in rviz. A terrain with particles
+// (the DEM soil) is prepared on a thread of its own (the manager keeps loading the other nodelets;
+// the vehicle waits for the first answer) and shows its particles and tools (the moving patch's
+// leveling cylinder and plate, bounding sphere, box and emitter zone) every 1 / cloud_rate of
+// simulated time. The service terrain/report gives the terrain's own figures for the run's result.
+// No physics here: the core computes, the nodelet converts.
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <thread>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
-#include <cmath>
+#include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "dem_mobility/TerrainReport.h"
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/result_file.h"
+#include "dem_mobility/core/dem/dem_system.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 #include "dem_mobility/ros/conversions.h"
 #include "dem_mobility/ros/core_names.h"
+#include "dem_mobility/ros/dem_visuals.h"
 
 namespace dem_mobility {
 
 class TerrainNodelet : public nodelet::Nodelet {
  public:
   ~TerrainNodelet() override {
+    if (prepare_.joinable()) prepare_.join();  // a preparation cannot be cut short
     responder_.reset();  // the vehicle learns at once that its terrain is gone
     if (served_ > 0) NODELET_INFO("terrain: %lu exchanges answered", static_cast<unsigned long>(served_));
   }
@@ -28,36 +44,90 @@ class TerrainNodelet : public nodelet::Nodelet {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     std::string transport;
-    std::unique_ptr<ExchangeServer<WheelStates, WheelWrenches>> server;
+    MobilityRunParams scene;
+    ExchangeTiming timing;
+    exchange_name_ = nh.resolveName("exchange/terrain");
     try {
-      const MobilityRunParams scene = LoadScene(nh);
-      const ExchangeTiming timing = LoadExchangeTiming(pnh, &transport);
+      scene = LoadScene(nh);
+      timing = LoadExchangeTiming(pnh, &transport);
       pnh.param<std::string>("frame_id", frame_id_, "odom");
-      model_ = LoadTerrainModel(scene.terrain_file, TerrainVehicle{VehicleSpec::Load(scene.vehicle_file).tire, kWheels});
-      server = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
-          nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches", timing);
-      NODELET_INFO("terrain '%s' from %s (%zu triangles), exchange over %s", model_->description().model.c_str(),
-                   scene.terrain_file.c_str(), model_->Surface().faces.size(), transport.c_str());
+      pnh.param("cloud_rate", cloud_rate_, cloud_rate_);
+      if (!(cloud_rate_ > 0.0 && std::isfinite(cloud_rate_)))
+        throw ConfigError("parameter " + pnh.resolveName("cloud_rate") + " must be > 0 Hz of simulated time");
     } catch (const std::exception& e) {
-      NODELET_FATAL("%s", e.what());
-      failed_ = RefuseExchange<WheelStates, WheelWrenches>(transport, nh.resolveName("exchange/terrain"),
-                                                          std::string("the terrain could not start: ") + e.what());
+      Refuse(transport, e.what());
       return;
     }
     markers_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/markers", 1, true);
-    PublishSurface();
+    cloud_ = nh.advertise<sensor_msgs::PointCloud2>("terrain/particles", 2);
+    tools_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/tools", 2);
+    report_ = nh.advertiseService("terrain/report", &TerrainNodelet::Report, this);
+    // a DEM soil takes minutes to prepare: not in the manager's loading thread
+    prepare_ = std::thread([this, scene, transport, timing, nh]() mutable { Prepare(nh, scene, transport, timing); });
+  }
+
+  void Prepare(ros::NodeHandle nh, const MobilityRunParams& scene, const std::string& transport,
+               const ExchangeTiming& timing) {
+    std::unique_ptr<ExchangeServer<WheelStates, WheelWrenches>> server;
+    try {
+      const TerrainDescription d = DescribeTerrain(scene.terrain_file, scene.terrain_overrides);
+      if (d.time_step > 0.0)
+        NODELET_INFO("terrain '%s' from %s (level '%s'): preparing ...", d.model.c_str(), scene.terrain_file.c_str(),
+                     d.fidelity.c_str());
+      const auto t0 = std::chrono::steady_clock::now();
+      std::unique_ptr<TerrainModel> model = LoadTerrainModel(
+          scene.terrain_file, TerrainVehicle{VehicleSpec::Load(scene.vehicle_file).tire, kWheels}, scene.terrain_overrides);
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      server = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
+          nh, transport, exchange_name_, "exchange/wheel_states", "exchange/wheel_wrenches", timing);
+      const TerrainDisplay shown = model->Display();
+      if (shown.dem)
+        NODELET_INFO("terrain '%s' from %s: %d particles, prepared in %.1f s; particles every %.3g s of simulated "
+                     "time on %s",
+                     model->description().model.c_str(), scene.terrain_file.c_str(), shown.dem->num_alive(), wall,
+                     1.0 / cloud_rate_, cloud_.getTopic().c_str());
+      NODELET_INFO("terrain '%s' from %s (%zu triangles), exchange over %s", model->description().model.c_str(),
+                   scene.terrain_file.c_str(), model->Surface().faces.size(), transport.c_str());
+      std::lock_guard<std::mutex> lock(mutex_);
+      model_ = std::move(model);
+      PublishSurface();
+    } catch (const std::exception& e) {
+      Refuse(transport, e.what());
+      return;
+    }
     responder_ = std::make_unique<ExchangeResponder<WheelStates, WheelWrenches>>(
         std::move(server), "terrain", [this](const WheelStates& req) { return Answer(req); },
         [this](const std::string& m) { NODELET_ERROR("%s", m.c_str()); },
         [this](const std::string& m) { NODELET_INFO("%s", m.c_str()); });
   }
 
-  /// The wrenches of one exchange (the model's, converted).
+  /// The terrain could not start: said clearly; the vehicle finds the exchange closed with the reason.
+  void Refuse(const std::string& transport, const std::string& what) {
+    NODELET_FATAL("%s", what.c_str());
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      error_ = what;
+    }
+    failed_ = RefuseExchange<WheelStates, WheelWrenches>(transport.empty() ? "inline" : transport, exchange_name_,
+                                                        "the terrain could not start: " + what);
+  }
+
+  /// The wrenches of one exchange (the model's, converted); the particles and tools of the state
+  /// the wheels are synchronized with, when a display frame is due.
   WheelWrenches::ConstPtr Answer(const WheelStates& req) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const double t = req.header.stamp.toSec();
     FromMsg(req, &states_);
-    model_->Synchronize(static_cast<long>(req.step), req.header.stamp.toSec(), states_);
+    model_->Synchronize(static_cast<long>(req.step), t, states_);
     model_->GetWrenches(&wrenches_);
+    const TerrainDisplay shown = model_->Display();
+    if (shown.dem && t >= next_frame_ - 1e-9) {
+      PublishFrame(shown, req.header.stamp);
+      // from the step's time on, so that a long exchange interval does not bunch the frames
+      next_frame_ = (std::floor(t * cloud_rate_ + 1e-6) + 1.0) / cloud_rate_;
+    }
     model_->Advance(req.time_step);
+    time_ = t + req.time_step;
     auto resp = boost::make_shared<WheelWrenches>();
     resp->header.stamp = req.header.stamp;
     resp->header.frame_id = req.header.frame_id;
@@ -67,60 +137,163 @@ class TerrainNodelet : public nodelet::Nodelet {
     return resp;
   }
 
-  void PublishSurface() {
-    const TriMesh& mesh = model_->Surface();
-    visualization_msgs::MarkerArray arr;
+  bool Report(TerrainReport::Request&, TerrainReport::Response& res) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    res.time = time_;
+    res.served = served_;
+    if (!model_) {
+      res.error = error_.empty() ? "the terrain is not prepared yet" : "the terrain could not start: " + error_;
+      res.figures = "{}";
+      return true;
+    }
+    res.model = model_->description().model;
+    ResultFile f("", "");
+    model_->Describe(&f);
+    // the figures alone: the schema's own keys (scene, kind, status, error) belong to the run
+    const YAML::Node all = YAML::Load(f.Text());
+    YAML::Emitter e;
+    e.SetDoublePrecision(17);
+    e << YAML::BeginMap;
+    for (const auto& kv : all) {
+      const std::string key = kv.first.as<std::string>();
+      if (key == "scene" || key == "kind" || key == "status" || key == "error") continue;
+      e << YAML::Key << key << YAML::Value << kv.second;
+    }
+    e << YAML::EndMap;
+    res.figures = e.c_str();
+    return true;
+  }
+
+  // --- display
+
+  static geometry_msgs::Point P(double x, double y, double z) {
+    geometry_msgs::Point p;
+    p.x = x;
+    p.y = y;
+    p.z = z;
+    return p;
+  }
+
+  visualization_msgs::Marker Marker(const std::string& ns, int type, float r, float g, float b, float a) const {
     visualization_msgs::Marker m;
     m.header.frame_id = frame_id_;
-    m.ns = "terrain_surface";
-    m.id = 0;
-    m.type = visualization_msgs::Marker::TRIANGLE_LIST;
+    m.ns = ns;
+    m.type = type;
     m.action = visualization_msgs::Marker::ADD;
     m.pose.orientation.w = 1.0;
     m.scale.x = m.scale.y = m.scale.z = 1.0;
-    m.color.r = 0.42f;
-    m.color.g = 0.42f;
-    m.color.b = 0.45f;
-    m.color.a = 1.0f;
+    m.color.r = r;
+    m.color.g = g;
+    m.color.b = b;
+    m.color.a = a;
+    return m;
+  }
+
+  void PublishFrame(const TerrainDisplay& d, const ros::Time& stamp) {
+    const DemSystem& s = *d.dem;
+    auto cloud = boost::make_shared<sensor_msgs::PointCloud2>();
+    ToPointCloud(s, &first_shown_, cloud.get());
+    cloud->header.stamp = stamp;
+    cloud->header.frame_id = frame_id_;
+    cloud_.publish(cloud);
+
+    auto arr = boost::make_shared<visualization_msgs::MarkerArray>();
+    static const float kTool[][4] = {{0.75f, 0.75f, 0.8f, 1.0f}, {0.35f, 0.55f, 0.85f, 0.8f}};
+    int k = 0;
+    for (int w : d.walls) {
+      const float* c = kTool[std::min(k++, 1)];
+      visualization_msgs::Marker m = WallMarker(s.wall(w), s.wall(w).name, 0, c[0], c[1], c[2], c[3]);
+      m.header.frame_id = frame_id_;
+      arr->markers.push_back(m);
+    }
+    if (d.patch) {
+      const double y0 = -0.5 * d.box_width, y1 = 0.5 * d.box_width, z0 = d.floor_z, z1 = d.floor_z + d.box_height;
+      // the bounding sphere: three great circles (a translucent ball would wash the soil out)
+      auto sphere = Marker("patch_sphere", visualization_msgs::Marker::LINE_LIST, 0.3f, 0.8f, 1.0f, 0.35f);
+      sphere.scale.x = 0.02;
+      const Eigen::Vector3d c = d.sphere_centre;
+      const double r = d.sphere_radius;
+      const int n = 72;
+      for (int plane = 0; plane < 3; ++plane)
+        for (int i = 0; i < n; ++i)
+          for (int j : {i, i + 1}) {
+            const double a = 2.0 * M_PI * j / n, u = r * std::cos(a), v = r * std::sin(a);
+            const Eigen::Vector3d q = plane == 0 ? Eigen::Vector3d(u, v, 0) : plane == 1 ? Eigen::Vector3d(u, 0, v)
+                                                                                         : Eigen::Vector3d(0, u, v);
+            sphere.points.push_back(P(c.x() + q.x(), c.y() + q.y(), c.z() + q.z()));
+          }
+      arr->markers.push_back(sphere);
+      // the box that follows the vehicle: its twelve edges
+      auto box = Marker("patch_box", visualization_msgs::Marker::LINE_LIST, 1.0f, 1.0f, 1.0f, 0.7f);
+      box.scale.x = 0.025;
+      const double xs[2] = {d.box_rear, d.box_front}, ys[2] = {y0, y1}, zs[2] = {z0, z1};
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+          box.points.push_back(P(xs[0], ys[a], zs[b]));
+          box.points.push_back(P(xs[1], ys[a], zs[b]));
+          box.points.push_back(P(xs[a], ys[0], zs[b]));
+          box.points.push_back(P(xs[a], ys[1], zs[b]));
+          box.points.push_back(P(xs[a], ys[b], zs[0]));
+          box.points.push_back(P(xs[a], ys[b], zs[1]));
+        }
+      arr->markers.push_back(box);
+      // the emitter's zone: the layer being filled, floor to the prepared surface
+      auto emitter = Marker("patch_emitter", visualization_msgs::Marker::CUBE, 1.0f, 0.55f, 0.0f, 0.45f);
+      const double ztop = surface_z_;
+      emitter.pose.position = P(0.5 * (d.emitter_from + d.emitter_to), 0.0, 0.5 * (z0 + ztop));
+      emitter.scale.x = std::max(d.emitter_to - d.emitter_from, 0.02);
+      emitter.scale.y = d.box_width;
+      emitter.scale.z = std::max(ztop - z0, 0.02);
+      arr->markers.push_back(emitter);
+    }
+    for (auto& m : arr->markers) m.header.stamp = stamp;
+    tools_.publish(arr);
+  }
+
+  void PublishSurface() {
+    const TriMesh& mesh = model_->Surface();
+    // a terrain with particles: its surface only hints where the soil goes on (translucent)
+    const bool particles = model_->Display().dem != nullptr;
+    visualization_msgs::MarkerArray arr;
+    auto m = Marker("terrain_surface", visualization_msgs::Marker::TRIANGLE_LIST, 0.42f, 0.42f, 0.45f, 1.0f);
+    if (particles) {
+      m.color.r = 0.55f;
+      m.color.g = 0.45f;
+      m.color.b = 0.35f;
+      m.color.a = 0.25f;
+    }
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e30), hi = -lo;
     for (const auto& f : mesh.faces)
       for (int k = 0; k < 3; ++k) {
         const Eigen::Vector3d& v = mesh.vertices[f[k]];
-        geometry_msgs::Point p;
-        p.x = v.x();
-        p.y = v.y();
-        p.z = v.z();
-        m.points.push_back(p);
+        m.points.push_back(P(v.x(), v.y(), v.z()));
         lo = lo.cwiseMin(v);
         hi = hi.cwiseMax(v);
       }
+    surface_z_ = hi.z();
     arr.markers.push_back(m);
     // cross lines every 5 m so that motion along the surface is visible
-    visualization_msgs::Marker l = m;
-    l.ns = "terrain_lines";
-    l.type = visualization_msgs::Marker::LINE_LIST;
-    l.points.clear();
+    auto l = Marker("terrain_lines", visualization_msgs::Marker::LINE_LIST, 0.9f, 0.9f, 0.9f, particles ? 0.5f : 1.0f);
     l.scale.x = 0.05;
-    l.color.r = l.color.g = l.color.b = 0.9f;
     for (double x = std::ceil(lo.x() / 5.0) * 5.0; x <= hi.x(); x += 5.0) {
-      geometry_msgs::Point a, b;
-      a.x = b.x = x;
-      a.y = lo.y();
-      b.y = hi.y();
-      a.z = b.z = hi.z() + 0.005;
-      l.points.push_back(a);
-      l.points.push_back(b);
+      l.points.push_back(P(x, lo.y(), hi.z() + 0.005));
+      l.points.push_back(P(x, hi.y(), hi.z() + 0.005));
     }
     arr.markers.push_back(l);
     markers_.publish(arr);
   }
 
-
+  std::mutex mutex_;  ///< the model: the exchange (whatever thread runs it) and the report
   std::unique_ptr<TerrainModel> model_;
+  std::string error_;
   std::unique_ptr<ExchangeResponder<WheelStates, WheelWrenches>> responder_;
   std::shared_ptr<Channel<WheelStates, WheelWrenches>> failed_;  ///< held closed when the setup failed
-  ros::Publisher markers_;
-  std::string frame_id_;
+  std::thread prepare_;
+  ros::Publisher markers_, cloud_, tools_;
+  ros::ServiceServer report_;
+  std::string frame_id_ = "odom", exchange_name_;
+  double cloud_rate_ = 10.0, next_frame_ = 0.0, time_ = 0.0, surface_z_ = 0.0;
+  std::vector<float> first_shown_;  ///< each particle's plastic strain when first shown (by ID)
   std::vector<WheelState> states_;
   std::vector<WheelWrench> wrenches_;
   uint64_t served_ = 0;

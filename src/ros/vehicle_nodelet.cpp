@@ -1,7 +1,9 @@
 // dem_mobility/VehicleNodelet: the vehicle side of the co-simulation and its clock. Runs the core's
 // scene loop (RunCoSimulation) with the terrain and the driver reached through lock-step exchanges,
 // and publishes what users watch and keep: /clock, tf (every body), odometry, the exchanged wheel
-// states, wrenches and driver commands (decimated to log_rate), markers, progress, the result.
+// states, wrenches and driver commands (decimated to log_rate), markers, progress, the result. The
+// result YAML holds the terrain's own figures too (a DEM soil's level, table, patch checks): the
+// terrain nodelet gives them through its service terrain/report once the run is over.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -17,6 +19,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "dem_mobility/MobilityResult.h"
+#include "dem_mobility/TerrainReport.h"
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/cosim/cosim_loop.h"
@@ -140,13 +143,18 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
           std::make_unique<ExchangeClient<WheelStates, WheelWrenches>>(
               nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches",
               "terrain", timing),
-          world_frame_, DescribeTerrain(scene_.terrain_file));
+          world_frame_, DescribeTerrain(scene_.terrain_file, scene_.terrain_overrides));
       driver_ = std::make_unique<ExchangeDriverPort>(std::make_unique<ExchangeClient<dem_mobility::DriverInput, dem_mobility::DriverCommand>>(
           nh, transport, nh.resolveName("exchange/driver"), "exchange/driver_input", "exchange/driver_command", "driver",
           timing));
       NODELET_INFO("vehicle '%s' (%d bodies) on %s, grade %.2f deg, exchange over %s",
                    sim_->vehicle().name().c_str(), sim_->vehicle().system().num_bodies() - 1, scene_.file.c_str(),
                    scene_.grade_deg, transport.c_str());
+      const TerrainDescription& d = terrain_->description();
+      if (d.time_step > 0.0)
+        NODELET_INFO("terrain '%s' (level '%s', cone index %.4g psi, its own step %.4g s): waiting up to %.0f s for "
+                     "it to be prepared",
+                     d.model.c_str(), d.fidelity.c_str(), d.cone_index, d.time_step, timing.startup_timeout);
     } catch (const std::exception& e) {
       Fail(std::string(e.what()));
       return;
@@ -202,10 +210,13 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       log_every_ = log_rate_ > 0.0 ? std::max(1L, std::lround(1.0 / (log_rate_ * dt))) : 1;
       clock_every_ = std::max(1L, std::lround(1.0 / (clock_rate_ * dt)));
       driver_->stamp_offset = scene_.settle_time;
-      NODELET_INFO("time step %.4g s (critical %.4g s: %s), coupling every %d step(s), logging every %ld step(s), "
-                   "%.1f s of driving after %.2f s of settling",
-                   dt, sim_->limit().dt_crit, sim_->limit().element.c_str(), scene_.coupling_interval, log_every_,
-                   scene_.duration, scene_.settle_time);
+      // the coupling in use: with a terrain of its own step (a DEM soil) and time_step auto, the
+      // vehicle steps that fit in one terrain step times the scene's coupling_interval
+      NODELET_INFO("time step %.4g s (critical %.4g s: %s), coupling every %d step(s) (%.4g s; scene's "
+                   "coupling_interval %d), logging every %ld step(s), %.1f s of driving after %.2f s of settling",
+                   dt, sim_->limit().dt_crit, sim_->limit().element.c_str(), sim_->coupling_interval(),
+                   dt * sim_->coupling_interval(), scene_.coupling_interval, log_every_, scene_.duration,
+                   scene_.settle_time);
       wall0_ = std::chrono::steady_clock::now();
       r = RunCoSimulation(*sim_, *terrain_, *driver_, this);
     } catch (const std::exception& e) {  // configuration errors (time step) before the first step
@@ -243,7 +254,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     if (wall < next_progress_) return;
     next_progress_ += 1.0;
     const double t = std::max(0.0, sim.driver_time()), rtf = sim.time() / wall;
-    NODELET_INFO("t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s", t, scene_.duration,
+    NODELET_INFO("t = %6.2f / %.4g s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s", t, scene_.duration,
                  sim.vehicle().ForwardSpeed(), rtf, (scene_.duration - t) / std::max(rtf, 1e-9));
   }
 
@@ -276,25 +287,39 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   }
 
   void Finish(const MobilityRunResult& r) {
+    // the terrain's figures first: its state is final now (the last exchange has been answered)
+    std::string report_error;
+    const YAML::Node terrain = TerrainFigures(&report_error);
     MobilityResult m;
     m.header.stamp = ros::Time(sim_ ? sim_->time() : 0.0);
     m.header.frame_id = world_frame_;
     m.scene = scene_.file;
+    m.kind = scene_.kind;
     m.grade_deg = scene_.grade_deg;
     m.cone_index_psi = r.cone_index;
     m.terrain_model = r.terrain_model;
+    m.fidelity = r.terrain.fidelity;
     m.speed_made_good = r.smg.value;
+    m.speed_made_good_mph = r.smg.value / 0.44704;
     m.status = r.Status();
     m.window_slope = r.smg.window_slope;
+    m.window_speed_std = r.smg.window_std;
+    m.window_samples = static_cast<uint32_t>(r.steady.samples);
+    m.slip.assign(r.steady.slip.begin(), r.steady.slip.end());
+    m.sinkage.assign(r.steady.sinkage.begin(), r.steady.sinkage.end());
+    m.traction_coefficient = r.steady.traction_coefficient;
+    m.motion_resistance_coefficient = r.steady.motion_resistance;
+    m.drawbar_margin = r.steady.drawbar_margin;
     m.time_step = r.dt;
+    m.terrain_time_step = r.terrain.time_step;
     m.critical_time_step = r.dt_crit;
     m.critical_element = r.dt_limit_element;
-    m.coupling_interval = static_cast<uint32_t>(scene_.coupling_interval);
+    m.coupling_interval = static_cast<uint32_t>(r.coupling_interval);
     m.steps = static_cast<uint64_t>(r.steps);
     m.exchanges = static_cast<uint64_t>(r.exchanges);
     m.simulated_time = r.sim_time;
     m.wall_time = r.wall_time;
-    m.real_time_factor = r.wall_time > 0.0 && sim_ ? sim_->time() / r.wall_time : 0.0;
+    m.real_time_factor = r.wall_time > 0.0 ? r.sim_time / r.wall_time : 0.0;  // as in the result YAML
     m.error = r.error;
     result_.Publish(m);
     if (!r.error.empty()) NODELET_ERROR("run failed: %s", r.error.c_str());
@@ -304,7 +329,12 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       std::vector<std::pair<std::string, long>> counts;
       for (const Counted* c : counted_) counts.emplace_back(c->name, c->count);
       try {
-        MobilityResultFile(r, scene_, counts).Write(result_file_);
+        // as the in-process runner writes it (MobilityResultFile with the terrain model): the
+        // terrain's figures after the run's, in the terrain's order
+        ResultFile f = MobilityResultFile(r, scene_, counts);
+        for (const auto& kv : terrain) f.Set(kv.first.as<std::string>(), kv.second);
+        if (!report_error.empty()) f.Set("terrain_report", "missing: " + report_error);
+        f.Write(result_file_);
         NODELET_INFO("result: %s", result_file_.c_str());
       } catch (const std::exception& e) {
         NODELET_ERROR("%s", e.what());
@@ -313,11 +343,46 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     if (shutdown_when_done_) ros::requestShutdown();
   }
 
+  /// The terrain's own figures (a YAML map; empty when it has none or could not give them: then
+  /// `error` says why), from the terrain nodelet's service terrain/report.
+  YAML::Node TerrainFigures(std::string* error) {
+    ros::ServiceClient client = getNodeHandle().serviceClient<TerrainReport>("terrain/report");
+    TerrainReport srv;
+    // the terrain nodelet advertises it when it loads; one that is gone (unloaded, killed) is not
+    // waited for long
+    if (!client.waitForExistence(ros::Duration(2.0))) {
+      *error = "no terrain answers " + client.getService();
+    } else if (!client.call(srv)) {
+      *error = client.getService() + " failed";
+    } else if (!srv.response.error.empty()) {
+      *error = srv.response.error;
+    } else {
+      try {
+        const YAML::Node n = YAML::Load(srv.response.figures);
+        if (n.IsMap()) return n;
+        *error = client.getService() + " answered no map of figures";
+      } catch (const YAML::Exception& e) {
+        *error = client.getService() + " answered malformed YAML: " + e.what();
+      }
+    }
+    NODELET_WARN("the result goes without the terrain's own figures: %s", error->c_str());
+    return YAML::Node(YAML::NodeType::Map);
+  }
+
   /// A setup error: said clearly, written to the result file when one is set, and the run ends.
   void Fail(const std::string& what) {
     NODELET_FATAL("%s", what.c_str());
     if (!result_file_.empty()) {
-      ResultFile r(scene_.file, "road_slope");
+      std::string file = scene_.file, kind = scene_.kind;
+      if (file.empty()) {  // the scene did not load: its file and kind, if it reads as YAML
+        try {
+          const YamlReader y = LoadSceneFile(getNodeHandle());
+          file = y.file();
+          kind = y.String("scene");
+        } catch (const std::exception&) {
+        }
+      }
+      ResultFile r(file, kind);
       r.SetStatus("error", what);
       try {
         r.Write(result_file_);

@@ -20,6 +20,15 @@ namespace dem_mobility {
 void ToPointCloud(const DemSystem& s, sensor_msgs::PointCloud2* cloud,
                   const std::function<bool(const Eigen::Vector3d&)>& keep = nullptr);
 
+/// Every live particle with float32 fields x, y, z, plastic_strain (delta_p / d) and
+/// plastic_strain_change: the change of its plastic strain since it was first shown, which
+/// `first_shown` (indexed by ID, grown as needed, NaN: not shown yet) keeps from call to call. On a
+/// soil under a vehicle the compaction under the wheels shows as a gain, where the prepared bed's
+/// own strain (its consolidation, spread over a range) would hide it; the strain also relaxes
+/// (eq. 16), so the change has either sign. A re-emitted particle has a new ID: it starts from the
+/// state it was laid down with. In ID order.
+void ToPointCloud(const DemSystem& s, std::vector<float>* first_shown, sensor_msgs::PointCloud2* cloud);
+
 /// One wall as a TRIANGLE_LIST marker in its body frame, posed at the wall's pose.
 visualization_msgs::Marker WallMarker(const DemWall& w, const std::string& ns, int id, float r, float g, float b,
                                       float a);
