@@ -19,6 +19,7 @@
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/cosim/cosim_loop.h"
 #include "dem_mobility/core/mobility/mobility_scene.h"
+#include "dem_mobility/core/scenes/soil_prep.h"
 #include "dem_mobility/core/terrain/dem_soil.h"
 #include "dem_mobility/core/terrain/soil_patch.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
@@ -85,6 +86,23 @@ void Drive(DemSoilTerrain* t, double x0, double z, double v, long steps, const s
     t->GetWrenches(&w);
     t->Advance(h);
     if (each) each(k);
+  }
+}
+
+TEST(SoilPatch, PoursItsPartialTopLayerEvenlyAcrossTheWidth) {
+  // 2.5 layers of 10 x 10 sites: the half layer on top covers both halves of the region alike
+  const double d = 0.1;
+  const auto inside = [](double, double) { return true; };
+  for (bool spread : {false, true}) {
+    const std::vector<Vector3d> x = PourLattice(250, d, 1.0, {0.0, 0.0}, {1.0 + 0.2 * d, 1.0 + 0.2 * d}, inside, 1, spread);
+    int low = 0, high = 0;
+    for (const Vector3d& p : x)
+      if (p.z() > 2.5 * d) (p.y() < 0.5 ? low : high) += 1;
+    ASSERT_EQ(low + high, 50);
+    if (spread)
+      EXPECT_EQ(low, high);
+    else
+      EXPECT_EQ(low, 50);  // the default: the first rows (kept for the scenes calibrated with it)
   }
 }
 
@@ -159,14 +177,17 @@ TEST(VehicleOnSoil, AtRestCarriesItsWeightAndStopsSinking) {
   // the weight and the sinkage over two windows of the settling
   struct Watch final : public CoSimObserver {
     double fz[3] = {0, 0, 0}, sink[3] = {0, 0, 0};
+    double wheel_sink[kWheels] = {0, 0, 0, 0};
     long n[3] = {0, 0, 0};
     void OnStep(const VehicleCoSim& sim, const DriverCommand&) override {
       const double t = sim.time();
       const int k = t >= 1.0 && t < 1.3 ? 0 : t >= 1.3 && t < 1.6 ? 1 : t >= 0.4 && t < 0.7 ? 2 : -1;
       if (k < 0) return;
-      for (const WheelWrench& w : sim.wheel_wrenches()) {
+      for (int i = 0; i < kWheels; ++i) {
+        const WheelWrench& w = sim.wheel_wrenches()[i];
         fz[k] += w.force.z();
         sink[k] += 0.25 * w.sinkage;
+        if (k == 1) wheel_sink[i] += w.sinkage;
       }
       ++n[k];
     }
@@ -181,6 +202,12 @@ TEST(VehicleOnSoil, AtRestCarriesItsWeightAndStopsSinking) {
   std::printf("weight %.0f N, wheels carry %.0f N; sinkage %.4f (0.4-0.7 s), %.4f (1.0-1.3 s), %.4f m (1.3-1.6 s)\n",
               weight, watch.fz[1] / watch.n[1], s_early, s0, s1);
   EXPECT_GT(s1, 0.0);
+  // a symmetric vehicle on a level bed: left and right wheels sink alike
+  const double* ws = watch.wheel_sink;
+  std::printf("sinkage per wheel (1.3-1.6 s): fl %.4f fr %.4f rl %.4f rr %.4f m\n", ws[0] / watch.n[1],
+              ws[1] / watch.n[1], ws[2] / watch.n[1], ws[3] / watch.n[1]);
+  EXPECT_LT(std::abs(ws[0] - ws[1]) / watch.n[1], 0.25 * s1) << "front left and right";
+  EXPECT_LT(std::abs(ws[2] - ws[3]) / watch.n[1], 0.25 * s1) << "rear left and right";
   // the sinkage stops growing: the cohesive soil creeps under the standing load, ever slower;
   // over the last 0.3 s it grows by less than 2.5 % of itself, at under half its mean rate
   // between the windows centred on 0.55 s and 1.15 s

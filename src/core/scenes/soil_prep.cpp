@@ -14,7 +14,8 @@ using Eigen::Vector2d;
 using Eigen::Vector3d;
 
 std::vector<Vector3d> PourLattice(int count, double d, double spacing, const Vector2d& lo, const Vector2d& hi,
-                                  const std::function<bool(double, double)>& inside, unsigned seed) {
+                                  const std::function<bool(double, double)>& inside, unsigned seed,
+                                  bool spread_last_layer) {
   const double a = spacing * d;
   std::vector<Vector2d> layer;
   for (double y = lo.y() + 0.6 * d; y <= hi.y() - 0.6 * d; y += a)
@@ -25,9 +26,13 @@ std::vector<Vector3d> PourLattice(int count, double d, double spacing, const Vec
   std::uniform_real_distribution<double> jitter(-0.08 * d, 0.08 * d);
   std::vector<Vector3d> out;
   out.reserve(count);
+  const int N = static_cast<int>(layer.size()), full = count / N * N, partial = count - full;
   for (int n = 0; n < count; ++n) {
-    const Vector2d& p = layer[n % layer.size()];
-    const int k = n / static_cast<int>(layer.size());
+    int site = n % N;
+    if (spread_last_layer && n >= full)  // evenly spaced sites of the layer, not its first rows
+      site = static_cast<int>((static_cast<long>(n - full) * 2 + 1) * N / (2L * partial));
+    const Vector2d& p = layer[site];
+    const int k = n / N;
     out.emplace_back(p.x() + jitter(rng), p.y() + jitter(rng), 0.6 * d + k * a + jitter(rng));
   }
   return out;

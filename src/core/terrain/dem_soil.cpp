@@ -166,7 +166,7 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
   const std::vector<Vector3d> lattice = PourLattice(
       p.ParticleCount(), d, 1.1, {0.0, 0.0}, {l.length, l.width},
       [&](double x, double y) { return x >= 0.6 * d && x <= l.length - 0.6 * d && y >= 0.6 * d && y <= l.width - 0.6 * d; },
-      p.seed);
+      p.seed, /*spread_last_layer=*/p.patch.enabled);  // a vehicle's patch: level across its width
   double top = 0.0;
   for (const Vector3d& x : lattice) top = std::max(top, x.z());
   wall_height_ = top + 2.0 * d;

@@ -20,9 +20,16 @@ namespace dem_mobility::core {
 /// Positions of `count` particles of diameter d on a jittered square lattice (spacing `spacing`
 /// d) over the floor z = 0, layer after layer, inside the region where `inside(x, y)` holds
 /// (checked for the particle's centre). Deterministic for a seed.
+///
+/// The last layer is partial. By default it takes the first sites in row order (y outermost), so
+/// it covers one side of the region: a bed a layer thicker there, which a lid then consolidates
+/// more than the other side. `spread_last_layer` spreads it evenly over the region instead (every
+/// row and column gets its share); the cone and single-wheel scenes keep the default, with which
+/// their calibration tables and results were made.
 std::vector<Eigen::Vector3d> PourLattice(int count, double d, double spacing, const Eigen::Vector2d& lo,
                                          const Eigen::Vector2d& hi,
-                                         const std::function<bool(double, double)>& inside, unsigned seed);
+                                         const std::function<bool(double, double)>& inside, unsigned seed,
+                                         bool spread_last_layer = false);
 
 /// A lid driven down onto the particles at a speed proportional to the force it still lacks of
 /// `target` (up to `max_speed`), so that it settles on the target without overshoot: its loop gain
