@@ -274,13 +274,19 @@ TEST(SingleWheelConfig, UsesTheCalibrationTableOfItsParticleSizeOnly) {
   coarse.bin.Describe(&r);
   EXPECT_NE(r.Text().find("calibration_table"), std::string::npos);
   EXPECT_NE(r.Text().find("calibration_error_vs_finest"), std::string::npos);
-  // tiny (0.1 m): no table is made at that size; a cone index is refused, f runs with its CI unknown
-  ExpectRefused({"fidelity=tiny", "cone_index=100"}, "particle_diameter");
+  // tiny (0.1 m): the table made at 0.1 m (level tiny_cal of the cone scene)
   const SingleWheelParams tiny =
-      SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"fidelity=tiny", "cohesion_factor=2"}));
-  EXPECT_FALSE(tiny.bin.calibration);
-  EXPECT_FALSE(std::isfinite(tiny.bin.ConeIndex()));
-  EXPECT_NE(tiny.bin.no_table_reason.find("0.1"), std::string::npos) << tiny.bin.no_table_reason;
+      SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"fidelity=tiny", "cone_index=100"}));
+  ASSERT_TRUE(tiny.bin.calibration);
+  EXPECT_DOUBLE_EQ(tiny.bin.calibration->particle_diameter, 0.1);
+  EXPECT_DOUBLE_EQ(tiny.bin.cohesion_factor, tiny.bin.calibration->CohesionFactor(100.0));
+  // medium (0.05 m): no table is made at that size; a cone index is refused, f runs with its CI unknown
+  ExpectRefused({"fidelity=medium", "cone_index=100"}, "particle_diameter");
+  const SingleWheelParams medium =
+      SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"fidelity=medium", "cohesion_factor=2"}));
+  EXPECT_FALSE(medium.bin.calibration);
+  EXPECT_FALSE(std::isfinite(medium.bin.ConeIndex()));
+  EXPECT_NE(medium.bin.no_table_reason.find("0.05"), std::string::npos) << medium.bin.no_table_reason;
 }
 
 TEST(SingleWheelRig, ALoadTheSoilCannotCarryIsReportedSunk) {

@@ -383,26 +383,8 @@ class RealTinyRun(unittest.TestCase):
     def test_tiny_run(self):
         tmp = tempfile.mkdtemp(prefix='dm_wheel_sweep_real_')
         self.addCleanup(shutil.rmtree, tmp, True)
-        # no table is made at tiny's 0.1 m particles: the coarse table relabelled for 0.1 m stands
-        # in (test data only), in a copy of the scene that points at it
-        cal = os.path.join(tmp, 'calibration')
-        os.makedirs(cal)
-        with open(os.path.join(ROOT, 'config', 'calibration', 'cone_index_mu0.1_d0.06.yaml')) as fh:
-            table = yaml.safe_load(fh)
-        table['particle_diameter'] = 0.1
-        table['fidelity'] = 'tiny'
-        with open(os.path.join(cal, 'cone_index_mu0.1_d0.1.yaml'), 'w') as fh:
-            yaml.safe_dump(table, fh)
-        with open(os.path.join(ROOT, 'config', 'scenes', 'single_wheel.yaml')) as fh:
-            scene = yaml.safe_load(fh)
-        for key in ('soil', 'tire'):
-            scene[key] = os.path.normpath(os.path.join(ROOT, 'config', 'scenes', scene[key]))
-        scene['calibration'] = cal
-        scene_file = os.path.join(tmp, 'single_wheel.yaml')
-        with open(scene_file, 'w') as fh:
-            yaml.safe_dump(scene, fh)
+        # CI 100 through the table made at tiny's 0.1 m particles (config/calibration/cone_index_mu0.1_d0.1.yaml)
         p = subprocess.run([sys.executable, SCRIPT, '--runner', 'core', '--dm-run-scene', dm_run_scene(),
-                            '--scene', scene_file,
                             '--fidelity', 'tiny', '--ci', '100', '--slip', '0.3', '--jobs', '1', '--progress', 'plain',
                             '--out', tmp], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
                            env=dict(os.environ, MPLBACKEND='Agg'), timeout=900)
