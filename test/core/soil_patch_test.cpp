@@ -108,15 +108,24 @@ TEST(SoilPatch, PoursItsPartialTopLayerEvenlyAcrossTheWidth) {
   const double d = 0.1;
   const auto inside = [](double, double) { return true; };
   for (bool spread : {false, true}) {
-    const std::vector<Vector3d> x = PourLattice(250, d, 1.0, {0.0, 0.0}, {1.0 + 0.2 * d, 1.0 + 0.2 * d}, inside, 1, spread);
-    int low = 0, high = 0;
-    for (const Vector3d& p : x)
-      if (p.z() > 2.5 * d) (p.y() < 0.5 ? low : high) += 1;
+    // 1.07 m: the 10 sites of a row leave 0.05 m more room than 0.6 d at the far wall
+    const std::vector<Vector3d> x = PourLattice(250, d, 1.0, {0.0, 0.0}, {1.07 + 0.2 * d, 1.07 + 0.2 * d}, inside, 1, spread);
+    const double mid = 0.5 * (1.07 + 0.2 * d);
+    int low = 0, high = 0, all_low = 0;
+    double y_sum = 0.0;
+    for (const Vector3d& p : x) {
+      if (p.z() > 2.5 * d) (p.y() < mid ? low : high) += 1;
+      if (p.y() < mid) ++all_low;
+      y_sum += p.y();
+    }
     ASSERT_EQ(low + high, 50);
-    if (spread)
+    if (spread) {
       EXPECT_EQ(low, high);
-    else
+      EXPECT_EQ(all_low, 125);                     // half of every layer on each side
+      EXPECT_NEAR(y_sum / x.size(), mid, 0.01 * d);  // centred (within the jitter's mean)
+    } else {
       EXPECT_EQ(low, 50);  // the default: the first rows (kept for the scenes calibrated with it)
+    }
   }
 }
 

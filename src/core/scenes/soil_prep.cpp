@@ -17,9 +17,17 @@ std::vector<Vector3d> PourLattice(int count, double d, double spacing, const Vec
                                   const std::function<bool(double, double)>& inside, unsigned seed,
                                   bool spread_last_layer) {
   const double a = spacing * d;
+  // the first site 0.6 d from the low walls; spread: the sites centred between the walls instead
+  // (from the low wall, the rows leave up to a spacing more room at the high side)
+  Vector2d first(lo.x() + 0.6 * d, lo.y() + 0.6 * d);
+  if (spread_last_layer)
+    for (int k = 0; k < 2; ++k) {
+      const double room = hi[k] - lo[k] - 1.2 * d;
+      first[k] += 0.5 * (room - std::floor(room / a + 1e-9) * a);
+    }
   std::vector<Vector2d> layer;
-  for (double y = lo.y() + 0.6 * d; y <= hi.y() - 0.6 * d; y += a)
-    for (double x = lo.x() + 0.6 * d; x <= hi.x() - 0.6 * d; x += a)
+  for (double y = first.y(); y <= hi.y() - 0.6 * d; y += a)
+    for (double x = first.x(); x <= hi.x() - 0.6 * d; x += a)
       if (inside(x, y)) layer.emplace_back(x, y);
   DM_THROW_UNLESS(!layer.empty(), "the pour region holds no particle of diameter ", d);
   std::mt19937 rng(seed);

@@ -21,11 +21,13 @@ namespace dem_mobility::core {
 /// d) over the floor z = 0, layer after layer, inside the region where `inside(x, y)` holds
 /// (checked for the particle's centre). Deterministic for a seed.
 ///
-/// The last layer is partial. By default it takes the first sites in row order (y outermost), so
-/// it covers one side of the region: a bed a layer thicker there, which a lid then consolidates
-/// more than the other side. `spread_last_layer` spreads it evenly over the region instead (every
-/// row and column gets its share); the cone and single-wheel scenes keep the default, with which
-/// their calibration tables and results were made.
+/// By default the lattice starts 0.6 d from the low walls, so its rows leave up to a spacing more
+/// room at the high side (a few per cent more particles per area on the low side of a small
+/// region), and the last, partial layer takes the first sites in row order (y outermost), so it
+/// covers one side: a bed thicker there, which a lid then consolidates more than the other side.
+/// `spread_last_layer` centres the lattice between the walls and spreads the last layer evenly
+/// over the region (every row and column gets its share): a level bed. The cone and single-wheel
+/// scenes keep the default, with which their calibration tables and results were made.
 std::vector<Eigen::Vector3d> PourLattice(int count, double d, double spacing, const Eigen::Vector2d& lo,
                                          const Eigen::Vector2d& hi,
                                          const std::function<bool(double, double)>& inside, unsigned seed,
