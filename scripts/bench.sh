@@ -93,7 +93,7 @@ fi
 
 if [ "$want" = all ] || [ "$want" = soil_scene ]; then
   # the vehicle on the patch at 12 deg, CI 100, driving; a 0.05 s window per level after the
-  # preparation, settling and 0.2 s of driving; the soil at the scene's threads (2)
+  # preparation, 0.3 s of settling and 0.2 s of driving; the soil at the scene's threads (2)
   "$DM_BUILD/core/bench/soil_scene_bench" "$DM_ROOT/config/scenes/soil_slope.yaml" "${DM_SOIL_LEVELS:-tiny,coarse}" \
-    "${DM_SOIL_WINDOW:-0.05}" grade_deg=12 terrain_overrides.cone_index=100
+    "${DM_SOIL_WINDOW:-0.05}" grade_deg=12 settle_time=0.3 terrain_overrides.cone_index=100
 fi

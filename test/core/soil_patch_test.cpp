@@ -196,7 +196,7 @@ MobilityRunParams SoilScene(double grade, const std::vector<std::string>& more =
 }
 
 TEST(VehicleOnSoil, AtRestCarriesItsWeightAndStopsSinking) {
-  MobilityRunParams p = SoilScene(0.0, {"settle_time=1.6", "duration=0.01"});
+  MobilityRunParams p = SoilScene(0.0, {"settle_time=2.4", "duration=0.01"});
   // the weight and the sinkage over two windows of the settling
   struct Watch final : public CoSimObserver {
     double fz[3] = {0, 0, 0}, sink[3] = {0, 0, 0};
@@ -204,7 +204,7 @@ TEST(VehicleOnSoil, AtRestCarriesItsWeightAndStopsSinking) {
     long n[3] = {0, 0, 0};
     void OnStep(const VehicleCoSim& sim, const DriverCommand&) override {
       const double t = sim.time();
-      const int k = t >= 1.0 && t < 1.3 ? 0 : t >= 1.3 && t < 1.6 ? 1 : t >= 0.4 && t < 0.7 ? 2 : -1;
+      const int k = t >= 1.8 && t < 2.1 ? 0 : t >= 2.1 && t < 2.4 ? 1 : t >= 0.4 && t < 0.7 ? 2 : -1;
       if (k < 0) return;
       for (int i = 0; i < kWheels; ++i) {
         const WheelWrench& w = sim.wheel_wrenches()[i];
@@ -222,20 +222,23 @@ TEST(VehicleOnSoil, AtRestCarriesItsWeightAndStopsSinking) {
   ASSERT_GT(watch.n[1], 0);
   EXPECT_NEAR(watch.fz[1] / watch.n[1], weight, 0.02 * weight);
   const double s_early = watch.sink[2] / watch.n[2], s0 = watch.sink[0] / watch.n[0], s1 = watch.sink[1] / watch.n[1];
-  std::printf("weight %.0f N, wheels carry %.0f N; sinkage %.4f (0.4-0.7 s), %.4f (1.0-1.3 s), %.4f m (1.3-1.6 s)\n",
+  std::printf("weight %.0f N, wheels carry %.0f N; sinkage %.4f (0.4-0.7 s), %.4f (1.8-2.1 s), %.4f m (2.1-2.4 s)\n",
               weight, watch.fz[1] / watch.n[1], s_early, s0, s1);
   EXPECT_GT(s1, 0.0);
   // a symmetric vehicle on a level bed: left and right wheels sink alike
   const double* ws = watch.wheel_sink;
-  std::printf("sinkage per wheel (1.3-1.6 s): fl %.4f fr %.4f rl %.4f rr %.4f m\n", ws[0] / watch.n[1],
+  std::printf("sinkage per wheel (2.1-2.4 s): fl %.4f fr %.4f rl %.4f rr %.4f m\n", ws[0] / watch.n[1],
               ws[1] / watch.n[1], ws[2] / watch.n[1], ws[3] / watch.n[1]);
-  EXPECT_LT(std::abs(ws[0] - ws[1]) / watch.n[1], 0.25 * s1) << "front left and right";
-  EXPECT_LT(std::abs(ws[2] - ws[3]) / watch.n[1], 0.25 * s1) << "rear left and right";
+  // (the left wheels against the right ones: one wheel's sinkage scatters by a quarter at this
+  // particle size, 0.4 of the tire's width; a bed thicker on one side showed as 50 % and more)
+  const double left = 0.5 * (ws[0] + ws[2]) / watch.n[1], right = 0.5 * (ws[1] + ws[3]) / watch.n[1];
+  EXPECT_LT(std::abs(left - right), 0.15 * s1) << "left " << left << " m, right " << right << " m";
   // the sinkage stops growing: the cohesive soil creeps under the standing load, ever slower;
-  // over the last 0.3 s it grows by less than 2.5 % of itself, at under half its mean rate
-  // between the windows centred on 0.55 s and 1.15 s
-  EXPECT_LT(s1 - s0, 0.025 * s1) << "sinkage " << s0 << " -> " << s1 << " m";
-  EXPECT_LT(s1 - s0, 0.25 * (s0 - s_early)) << "sinkage " << s_early << " -> " << s0 << " -> " << s1 << " m";
+  // over the last 0.3 s it grows by less than 1 % of itself, at under three quarters of its mean
+  // rate between the windows centred on 0.55 s and 1.95 s
+  EXPECT_LT(s1 - s0, 0.01 * s1) << "sinkage " << s0 << " -> " << s1 << " m";
+  EXPECT_LT((s1 - s0) / 0.3, 0.75 * (s0 - s_early) / 1.4)
+      << "sinkage " << s_early << " -> " << s0 << " -> " << s1 << " m";
 }
 
 TEST(VehicleOnSoil, StuckOnASteepGradeOfSoftSoilEndsTheRunWithZero) {

@@ -146,11 +146,12 @@ class SoilSlopeRuns(unittest.TestCase):
         self.assertEqual(r['terrain_model'], 'dem_soil')
         self.assertEqual(r['fidelity'], 'tiny')
         self.assertEqual(r['particle_diameter'], 0.1)
-        # f from the tiny level's table at CI 100: its cubic f(CI), evaluated here
+        # f from the tiny level's table at CI 100 (its [CI, f] rows, interpolated here)
         with open(os.path.join(ROOT, 'config', 'calibration', 'cone_index_mu0.1_d0.1.yaml')) as f:
-            c = yaml.safe_load(f)['cubic']
+            rows = yaml.safe_load(f)['table']
         self.assertEqual(r['cone_index_psi'], 100)
-        self.assertAlmostEqual(r['cohesion_factor'], c[0] * 1e6 + c[1] * 1e4 + c[2] * 100 + c[3], places=9)
+        self.assertAlmostEqual(r['cohesion_factor'], float(np.interp(100.0, [c for c, _ in rows], [f for _, f in rows])),
+                               places=12)
         self.assertGreater(r['particles'], 5000)
         self.assertGreater(r['soil_prepare_wall_time'], 0.0)
         for key in ('soil_time_step', 'soil_steps', 'patch_following', 'patch_reemitted', 'patch_density_ratio',
@@ -192,7 +193,7 @@ class SoilSlopeRuns(unittest.TestCase):
         self.assertEqual(list(m.sinkage), r['sinkage'])
         self.assertEqual(len(m.slip), 4)
         self.assertEqual(m.terrain_time_step, r['soil_time_step'])
-        self.assertTrue(math.isnan(m.cone_index_psi))  # f given directly, no table at d = 0.1
+        self.assertEqual(m.cone_index_psi, 100.0)  # the cone index asked for, through the level's table
 
     def test_bag_holds_the_soil_and_the_vehicle(self):
         c = {t: len(v) for t, v in self.msgs.items()}
