@@ -63,29 +63,37 @@ SoilPatch::SoilPatch(DemSoilBin* bin, const SoilPatchParams& p, unsigned seed)
   centre_ = centre0_;
   radius_ = std::sqrt(0.25 * bed_length_ * bed_length_ + 0.25 * width_ * width_ +
                       std::pow(0.5 * depth0_ + d_, 2)) + p.sphere_margin;
-  // the template: a slice of the bed's middle
   template_length_ = std::min(p.template_length, bed_length_ / 3.0);
-  const double xa = centre0_.x() - 0.5 * template_length_;
+  prev_layer_first_id_ = layer_first_id_ = n0_;
+}
+
+SoilPatch::SoilPatch(const SoilPatch& o, DemSoilBin* bin) : SoilPatch(o) { bin_ = bin; }
+
+void SoilPatch::CaptureTemplate() {
+  // the slice of the bed just behind its front wall (ahead of the front wheels and of the
+  // leveling tools' reach when the patch starts to follow), as the soil is then
+  const DemSystem& dem = bin_->dem();
+  const double xa = front_x0_ - std::min(0.3, 0.05 * bed_length_) - template_length_;
+  sites_.clear();
   dem.ForEachParticle([&](int id, const Vector3d& x, const Vector3d&) {
     if (x.x() >= xa && x.x() < xa + template_length_)
       sites_.push_back({Vector3d(x.x() - xa, x.y(), x.z()), dem.plastic_deformation(id)});
   });
-  DM_THROW_UNLESS(!sites_.empty(), "SoilPatch: no particles in the template slice");
+  if (sites_.empty())
+    throw SimulationError("dem_soil patch (" + bin_->params().file + "): no soil in the emitter's template slice");
   std::sort(sites_.begin(), sites_.end(), [](const Site& a, const Site& b) {
     if (a.x.x() != b.x.x()) return a.x.x() < b.x.x();
     if (a.x.y() != b.x.y()) return a.x.y() < b.x.y();
     return a.x.z() < b.x.z();
   });
   min_site_x_ = sites_.front().x.x();
+  layer_begin_.clear();
   for (size_t i = 0; i < sites_.size(); ++i) {
     const int layer = static_cast<int>(std::floor((sites_[i].x.x() - min_site_x_) / d_));
     while (static_cast<int>(layer_begin_.size()) <= layer) layer_begin_.push_back(static_cast<int>(i));
   }
   layer_begin_.push_back(static_cast<int>(sites_.size()));
-  prev_layer_first_id_ = layer_first_id_ = n0_;
 }
-
-SoilPatch::SoilPatch(const SoilPatch& o, DemSoilBin* bin) : SoilPatch(o) { bin_ = bin; }
 
 double SoilPatch::emitter_from() const {
   return layer_ < 0 ? front_x0_ : copy_origin_ + min_site_x_ + layer_ * d_;
@@ -233,12 +241,15 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   if (!started_) {
     started_ = true;
     tool_offset_ = front + p_.leveling_ahead - centre0_.x();
-    stats_.initial = Measure(front + p_.check_from, front + p_.check_to);
     check_every_ = std::max(1L, std::lround(p_.check_period / dt));
     PlaceTools(0.0);
   }
   if (!stats_.following && centroid >= centre0_.x()) {
     stats_.following = true;
+    // the soil as the vehicle meets it when the patch starts: the template the emitter lays down
+    // and the bed its checks compare with (the released bed still relaxes for a while)
+    CaptureTemplate();
+    stats_.initial = Measure(front + p_.check_from, front + p_.check_to);
     // the bin's front wall goes: the emitter lays the soil down beyond it from now on
     DemWall& fw = dem.mutable_wall(bin_->container_walls()[2]);
     fw.position.z() += 1000.0;
@@ -261,8 +272,12 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   const double zone_from = emitter_from() - 0.25 * d_, zone_to = emitter_to() + d_;
   const double near_lo = emitter_from() - 1.5 * d_, near_hi = emitter_to() + 1.5 * d_;
   zone_.clear();
+  // (the soil the emitter lays down, and what lies ahead of it, is not held to the sphere: laid a
+  // little less dense than the soil leaving at the rear, it would otherwise outrun the sphere's
+  // front and leave again at once)
+  const double sphere_to = (emitting ? emitter_from() : front_x0_) - 2.0 * d_;
   dem.ForEachParticle([&](int id, const Vector3d& x, const Vector3d&) {
-    if ((x - centre_).squaredNorm() > r2) {
+    if (x.x() < sphere_to && (x - centre_).squaredNorm() > r2) {
       out.push_back(id);
     } else if (stats_.following && (x.x() > zone_to || (emitting && x.x() >= zone_from && id < prev_layer_first_id_))) {
       out.push_back(id);

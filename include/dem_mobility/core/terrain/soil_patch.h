@@ -9,7 +9,9 @@
 //
 // The emitter lays the soil down again as the prepared bed was: it holds a template, the
 // particles of a slice of the bed (positions and plastic deformation, so the consolidation-
-// dependent adhesion comes back with them) taken after the preparation, and fills copies of it
+// dependent adhesion comes back with them) just behind its front, taken when the patch starts
+// to follow (the released bed relaxes for a while; the checks compare with the bed as it is
+// then, ahead of the front wheels), and fills copies of it
 // ahead of the bed's front one layer (one particle diameter along x) at a time, each re-emitted
 // particle at a random free site among the lowest of the layer being filled (the layer is laid
 // from the bottom up; a seeded generator: runs repeat bit for bit). A random point of a plane emitter would drop loose soil that the wheels then meet
@@ -46,7 +48,7 @@ struct PatchStats {
   long skipped_sites = 0;         ///< template sites skipped: soil already there
   int copies = 0;                 ///< template copies begun
   bool following = false;
-  PatchSoilMeasure initial;       ///< the bed ahead of the front wheels at the start
+  PatchSoilMeasure initial;       ///< the bed ahead of the front wheels when the patch starts to follow
   // the checks with at least 90 % re-emitted soil in the window
   int checks = 0;
   double density_ratio_mean = std::numeric_limits<double>::quiet_NaN();  ///< re-emitted / initial
@@ -86,6 +88,8 @@ class SoilPatch {
     Eigen::Vector3d x;  ///< relative to the copy's origin (x) and the scene (y, z)
     double plastic;
   };
+  /// The template and the emitter's layers from the bed as it is now.
+  void CaptureTemplate();
   void StartCopy();
   void NextLayer();
   /// The particles near the layer being filled.
