@@ -93,6 +93,33 @@ void SoilPatch::CaptureTemplate() {
     while (static_cast<int>(layer_begin_.size()) <= layer) layer_begin_.push_back(static_cast<int>(i));
   }
   layer_begin_.push_back(static_cast<int>(sites_.size()));
+  // the period of the copies: the shift (about the slice's length) at which the next copy's first
+  // layers clash least with the last ones of the copy before (fewest sites closer than the
+  // clearance, per length of soil laid); the slice's cut is no plane the soil fits across at
+  // every shift
+  const int layers = static_cast<int>(layer_begin_.size()) - 1;
+  const int head = layer_begin_[std::min(2, layers)], tail = layer_begin_[std::max(0, layers - 2)];
+  const double c2 = std::pow(p_.seam_clearance * d_, 2);
+  double best = -1.0;
+  for (int k = -12; k <= 6; ++k) {
+    const double period = template_length_ + k * 0.05 * d_;
+    int clash = 0;
+    for (int i = 0; i < head; ++i) {
+      const Vector3d a = sites_[i].x + Vector3d(period, 0, 0);
+      for (int j = tail; j < static_cast<int>(sites_.size()); ++j)
+        if ((sites_[j].x - a).squaredNorm() < c2) {
+          ++clash;
+          break;
+        }
+    }
+    // particles laid per length of soil: the most wins
+    const double laid = (static_cast<double>(sites_.size()) - clash) / period;
+    if (laid > best) {
+      best = laid;
+      period_ = period;
+      seam_clash_ = clash;
+    }
+  }
 }
 
 double SoilPatch::emitter_from() const {
@@ -142,7 +169,7 @@ void SoilPatch::StartCopy() {
     });
     copy_origin_ = std::max(front, front_x0_ - 0.5 * d_) + 0.4 * d_ - min_site_x_;
   } else {
-    copy_origin_ += template_length_;
+    copy_origin_ += period_;
   }
   ++stats_.copies;
 }

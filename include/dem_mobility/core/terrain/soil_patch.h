@@ -18,7 +18,8 @@
 // less dense than the consolidated bed; the template gives the bed's density and surface by
 // construction, and the patch checks both ahead of the front wheels against the initial bed.
 // Template sites that would overlap soil already there (at the seams between copies, or a
-// particle that fell or was thrown there) are skipped. A particle that strays into the emitter's zone (thrown ahead, or pushed by the plate)
+// particle that fell or was thrown there) are skipped; the copies follow each other at the shift
+// (about the slice's length) at which the fewest sites clash per length laid. A particle that strays into the emitter's zone (thrown ahead, or pushed by the plate)
 // is re-emitted like one that left the sphere.
 #pragma once
 
@@ -104,6 +105,8 @@ class SoilPatch {
   std::mt19937_64 rng_;
   double d_ = 0.0, bed_length_ = 0.0, width_ = 0.0, floor_z_ = 0.0, surface0_ = 0.0, depth0_ = 0.0;
   double front_x0_ = 0.0, template_length_ = 0.0, min_site_x_ = 0.0;
+  double period_ = 0.0;              ///< shift from one copy to the next
+  int seam_clash_ = 0;               ///< sites of a copy that clash with the copy before at that shift
   Eigen::Vector3d centre0_ = Eigen::Vector3d::Zero(), centre_ = Eigen::Vector3d::Zero();
   double radius_ = 0.0;
   int n0_ = 0;
