@@ -5,7 +5,11 @@
 // key=value overrides a scene key (dotted for nested keys: driver.kp=4000, grade_deg=12).
 // Arguments of the form __name:=value (added by roslaunch) are ignored. Exit status: 0 done, 1 bad
 // input (the message names the file and key), 2 usage, 3 a numerical failure during the run (the
-// result file, written all the same, holds what was measured).
+// result file, written all the same, holds what was measured), 4 a mobility run stopped by SIGINT
+// or SIGTERM (it ends at the next step and its result and history are written, status
+// interrupted).
+#include <atomic>
+#include <csignal>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -18,6 +22,9 @@
 using namespace dem_mobility::core;
 
 namespace {
+std::atomic<bool> g_stop{false};
+extern "C" void OnSignal(int) { g_stop.store(true); }
+
 int Usage() {
   std::cerr << "usage: dm_run_scene SCENE.yaml [key=value ...] [--out RESULT.yaml] [--history HISTORY.csv] [--quiet]\n"
                "scenes:";
@@ -32,6 +39,9 @@ int main(int argc, char** argv) {
   const std::string scene_file = argv[1];
   std::string out_file;
   SceneRunOptions options;
+  options.stop = &g_stop;
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
   std::vector<std::string> overrides;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -53,6 +63,11 @@ int main(int argc, char** argv) {
       std::cerr << "dm_run_scene: simulation error: " << result.error() << "\n";
       if (!out_file.empty()) std::cerr << "dm_run_scene: the results so far are in " << out_file << "\n";
       return 3;
+    }
+    if (result.status() == "interrupted") {
+      std::cerr << "dm_run_scene: interrupted" << (out_file.empty() ? "" : "; the results so far are in " + out_file)
+                << "\n";
+      return 4;
     }
   } catch (const ConfigError& e) {
     std::cerr << "dm_run_scene: error: " << e.what() << "\n";

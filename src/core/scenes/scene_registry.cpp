@@ -45,9 +45,11 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
   // progress on the console about once a second of wall time
   class Progress final : public CoSimObserver {
    public:
-    explicit Progress(double duration) : duration_(duration) {}
+    Progress(double duration, bool quiet, const std::atomic<bool>* stop)
+        : duration_(duration), quiet_(quiet), stop_(stop) {}
+    bool StopRequested() override { return stop_ && stop_->load(std::memory_order_relaxed); }
     void OnStep(const VehicleCoSim& sim, const DriverCommand&) override {
-      if ((sim.step() & 255) != 0 || !ticker_.Due()) return;
+      if (quiet_ || (sim.step() & 255) != 0 || !ticker_.Due()) return;
       const double t = std::max(0.0, sim.driver_time()), rtf = sim.time() / std::max(ticker_.Elapsed(), 1e-9);
       std::printf("  t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s\n", t, duration_,
                   sim.vehicle().ForwardSpeed(), rtf, (duration_ - t) / std::max(rtf, 1e-9));
@@ -56,9 +58,11 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
 
    private:
     double duration_;
+    bool quiet_;
+    const std::atomic<bool>* stop_;
     Ticker ticker_{1.0};
-  } progress(p.duration);
-  MobilityRunResult r = run.Run(o.quiet ? nullptr : &progress);
+  } progress(p.duration, o.quiet, o.stop);
+  MobilityRunResult r = run.Run(&progress);
   try {
     if (!o.history_file.empty()) WriteMobilityHistory(r, o.history_file);
   } catch (const ConfigError& e) {  // the run is kept: its result says what failed

@@ -4,6 +4,7 @@
 // (scenes/soil_rig.h), the mobility run in the vehicle, terrain and driver nodelets.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <string>
 #include <vector>
@@ -17,6 +18,9 @@ class YamlReader;
 struct SceneRunOptions {
   std::string history_file;  ///< mobility runs: the speed history as CSV ("" none)
   bool quiet = false;        ///< no progress lines
+  /// Mobility runs: when it turns true (a signal handler sets it) the run ends at the next step
+  /// with what it has (status interrupted; the result and history are written).
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct SceneKind {
