@@ -1,5 +1,7 @@
 // Bad input gives an error naming the file, the key path and the value.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+#include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -159,6 +161,32 @@ TEST(Config, RunnerExitsNonZeroWithTheMessage) {
   ss << in.rdbuf();
   EXPECT_NE(ss.str().find("road_slope.yaml: grade_deg: value 95 is outside the allowed range"), std::string::npos)
       << ss.str();
+}
+
+TEST(Config, RunnerInterruptedKeepsTheRunsResult) {
+  // a 40 s road run sent SIGTERM after 3 s: it ends at the next step, writes its result (status
+  // interrupted, the simulated time so far) and history, and exits 4
+  const fs::path dir = fs::temp_directory_path() / "dm_runner_interrupt";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string result = (dir / "r.yaml").string(), history = (dir / "h.csv").string();
+  const std::string cmd = "timeout --preserve-status -s TERM 3 " + std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR
+                          "/scenes/road_slope.yaml duration=40 --quiet --out " + result + " --history " + history +
+                          " 2> " + (dir / "err.txt").string();
+  const int rc = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(rc));
+  EXPECT_EQ(WEXITSTATUS(rc), 4);
+  const YAML::Node r = YAML::LoadFile(result);
+  EXPECT_EQ(r["status"].as<std::string>(), "interrupted");
+  EXPECT_TRUE(r["interrupted"].as<bool>());
+  const double t = r["simulated_time"].as<double>();
+  EXPECT_GT(t, 0.0);
+  EXPECT_LT(t, 40.0);
+  std::ifstream h(history);
+  std::string line;
+  long lines = 0;
+  while (std::getline(h, line)) ++lines;
+  EXPECT_GT(lines, 10);  // the samples so far (100 Hz)
 }
 
 }  // namespace

@@ -299,10 +299,10 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   const double zone_from = emitter_from() - 0.25 * d_, zone_to = emitter_to() + d_;
   const double near_lo = emitter_from() - 1.5 * d_, near_hi = emitter_to() + 1.5 * d_;
   zone_.clear();
-  // (the soil the emitter lays down, and what lies ahead of it, is not held to the sphere: laid a
-  // little less dense than the soil leaving at the rear, it would otherwise outrun the sphere's
-  // front and leave again at once)
-  const double sphere_to = (emitting ? emitter_from() : front_x0_) - 2.0 * d_;
+  // (only the sphere's rear half removes soil: the soil the emitter lays down ahead, a little less
+  // dense than the soil leaving at the rear, would otherwise reach past the sphere's front, leave
+  // at once and be laid further ahead, without end)
+  const double sphere_to = centre_.x();
   dem.ForEachParticle([&](int id, const Vector3d& x, const Vector3d&) {
     if (x.x() < sphere_to && (x - centre_).squaredNorm() > r2) {
       out.push_back(id);

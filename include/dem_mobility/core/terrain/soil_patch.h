@@ -1,7 +1,8 @@
 // The moving soil patch (paper section 4.2, fig. 18) over a prepared DemSoilBin: a bounding
 // sphere, an emitter ahead of the vehicle, and a leveling cylinder and plate at the initial soil
-// height. A particle that leaves the sphere is removed and re-emitted at once, so the particle
-// count never changes. Once the centroid of the wheel centres (the terrain sees the wheels, not
+// height. A particle that leaves the sphere's rear half is removed and re-emitted at once, so the
+// particle count never changes (the soil the emitter lays ahead drifts a little past the sphere's
+// front: held to the whole sphere it would leave again at once). Once the centroid of the wheel centres (the terrain sees the wheels, not
 // the chassis) reaches the sphere's initial centre, the sphere, the emitter and the leveling tools
 // follow it along x (the grade is the scene's rotated gravity, so x is along the slope). The floor
 // and side walls reach over the whole travel and their material does not move, which to the soil
