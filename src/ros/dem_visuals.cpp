@@ -72,13 +72,32 @@ void ToPointCloud(const DemSystem& s, std::vector<float>* first_shown, sensor_ms
   DM_THROW_UNLESS(written == n, "ToPointCloud: ", written, " live particles for num_alive() = ", n);
 }
 
-visualization_msgs::Marker WallMarker(const DemWall& w, const std::string& ns, int id, float r, float g, float b,
-                                      float a) {
+geometry_msgs::Point MakePoint(double x, double y, double z) {
+  geometry_msgs::Point p;
+  p.x = x;
+  p.y = y;
+  p.z = z;
+  return p;
+}
+
+visualization_msgs::Marker ColouredMarker(const std::string& ns, int type, float r, float g, float b, float a) {
   visualization_msgs::Marker m;
   m.ns = ns;
-  m.id = id;
-  m.type = visualization_msgs::Marker::TRIANGLE_LIST;
+  m.type = type;
   m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.scale.x = m.scale.y = m.scale.z = 1.0;
+  m.color.r = r;
+  m.color.g = g;
+  m.color.b = b;
+  m.color.a = a;
+  return m;
+}
+
+visualization_msgs::Marker WallMarker(const DemWall& w, const std::string& ns, int id, float r, float g, float b,
+                                      float a) {
+  visualization_msgs::Marker m = ColouredMarker(ns, visualization_msgs::Marker::TRIANGLE_LIST, r, g, b, a);
+  m.id = id;
   m.pose.position.x = w.position.x();
   m.pose.position.y = w.position.y();
   m.pose.position.z = w.position.z();
@@ -87,11 +106,6 @@ visualization_msgs::Marker WallMarker(const DemWall& w, const std::string& ns, i
   m.pose.orientation.y = q.y();
   m.pose.orientation.z = q.z();
   m.pose.orientation.w = q.w();
-  m.scale.x = m.scale.y = m.scale.z = 1.0;
-  m.color.r = r;
-  m.color.g = g;
-  m.color.b = b;
-  m.color.a = a;
   for (const auto& f : w.mesh.faces)
     for (int k = 0; k < 3; ++k) {
       geometry_msgs::Point p;

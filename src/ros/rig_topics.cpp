@@ -107,27 +107,6 @@ void SetPose(const Eigen::Vector3d& x, const Eigen::Quaterniond& q, geometry_msg
   pose->orientation.w = q.w();
 }
 
-geometry_msgs::Point Point(double x, double y, double z) {
-  geometry_msgs::Point p;
-  p.x = x;
-  p.y = y;
-  p.z = z;
-  return p;
-}
-
-visualization_msgs::Marker Coloured(const std::string& ns, int type, float r, float g, float b, float a) {
-  visualization_msgs::Marker m;
-  m.ns = ns;
-  m.type = type;
-  m.action = visualization_msgs::Marker::ADD;
-  m.pose.orientation.w = 1.0;
-  m.scale.x = m.scale.y = m.scale.z = 1.0;
-  m.color.r = r;
-  m.color.g = g;
-  m.color.b = b;
-  m.color.a = a;
-  return m;
-}
 
 /// The single-wheel rig (scenes/single_wheel.h): the soil's wrench on the wheel (wheel/wrench, in
 /// the frame `wheel`: at the wheel centre, axes parallel to the scene frame, on /tf), its samples
@@ -275,31 +254,32 @@ class WheelTopics final : public RigTopics {
     const double R = tire.radius, half = 0.5 * tire.width;
     // the prepared surface the sinkage is measured from, along the bin at the wheel's mid-plane
     const SingleWheelParams& p = wheel.params();
-    Marker surface = Coloured("surface", Marker::LINE_LIST, 1.0f, 1.0f, 1.0f, 0.8f);
+    Marker surface = ColouredMarker("surface", Marker::LINE_LIST, 1.0f, 1.0f, 1.0f, 0.8f);
     surface.scale.x = 0.012;
     for (double x = 0.0; x < p.bin.level.length; x += 0.1) {  // dashed
-      surface.points.push_back(Point(p.bin.origin.x() + x, w.position.y(), bin.surface_height()));
-      surface.points.push_back(Point(p.bin.origin.x() + std::min(x + 0.05, p.bin.level.length), w.position.y(),
+      surface.points.push_back(MakePoint(p.bin.origin.x() + x, w.position.y(), bin.surface_height()));
+      surface.points.push_back(MakePoint(p.bin.origin.x() + std::min(x + 0.05, p.bin.level.length), w.position.y(),
                                      bin.surface_height()));
     }
     markers->push_back(std::move(surface));
     // the tire: the surface the soil touches, at the wheel's pose (see-through: the rut shows)
     if (tire_.points.empty()) {
-      tire_ = Coloured("tire", Marker::TRIANGLE_LIST, 0.12f, 0.12f, 0.12f, 0.55f);
+      tire_ = ColouredMarker("tire", Marker::TRIANGLE_LIST, 0.12f, 0.12f, 0.12f, 0.55f);
       for (const auto& f : tire.soil_mesh.faces)
         for (int k = 0; k < 3; ++k) {
           const Eigen::Vector3d& v = tire.soil_mesh.vertices[f[k]];
-          tire_.points.push_back(Point(v.x(), v.y(), v.z()));
+          tire_.points.push_back(MakePoint(v.x(), v.y(), v.z()));
         }
     }
     Marker t = tire_;
     SetPose(w.position, w.orientation, &t.pose);
     markers->push_back(std::move(t));
     // two spokes on the side toward -y, turning with the wheel: its spin shows
-    Marker spokes = Coloured("spokes", Marker::LINE_LIST, 0.95f, 0.95f, 0.95f, 1.0f);
+    Marker spokes = ColouredMarker("spokes", Marker::LINE_LIST, 0.95f, 0.95f, 0.95f, 1.0f);
     spokes.scale.x = 0.03;
     const double r = 0.9 * R, ys = -half - 0.02;
-    for (const auto& [a, b] : {std::pair(Point(-r, ys, 0), Point(r, ys, 0)), std::pair(Point(0, ys, -r), Point(0, ys, r))}) {
+    for (const auto& [a, b] :
+         {std::pair(MakePoint(-r, ys, 0), MakePoint(r, ys, 0)), std::pair(MakePoint(0, ys, -r), MakePoint(0, ys, r))}) {
       spokes.points.push_back(a);
       spokes.points.push_back(b);
     }
@@ -308,7 +288,7 @@ class WheelTopics final : public RigTopics {
     // the carriage: the axle, an arm over the tire from the far side (the wrench shows in front
     // of it) and the beam back to the carriage; it moves with the wheel centre and does not turn
     const Eigen::Vector3d& c = w.position;
-    Marker axle = Coloured("carriage", Marker::CYLINDER, 0.6f, 0.6f, 0.6f, 1.0f);
+    Marker axle = ColouredMarker("carriage", Marker::CYLINDER, 0.6f, 0.6f, 0.6f, 1.0f);
     axle.id = 0;
     const double yo = half + 0.12, top = R + 0.35;
     SetPose(c + Eigen::Vector3d(0.0, 0.5 * yo, 0.0), Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX())),
@@ -316,12 +296,12 @@ class WheelTopics final : public RigTopics {
     axle.scale.x = axle.scale.y = 0.07;
     axle.scale.z = 1.5 * yo;
     markers->push_back(std::move(axle));
-    Marker frame = Coloured("carriage", Marker::LINE_LIST, 1.0f, 0.6f, 0.1f, 1.0f);
+    Marker frame = ColouredMarker("carriage", Marker::LINE_LIST, 1.0f, 0.6f, 0.1f, 1.0f);
     frame.id = 1;
     frame.scale.x = 0.05;
     auto line = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-      frame.points.push_back(Point(c.x() + a.x(), c.y() + a.y(), c.z() + a.z()));
-      frame.points.push_back(Point(c.x() + b.x(), c.y() + b.y(), c.z() + b.z()));
+      frame.points.push_back(MakePoint(c.x() + a.x(), c.y() + a.y(), c.z() + a.z()));
+      frame.points.push_back(MakePoint(c.x() + b.x(), c.y() + b.y(), c.z() + b.z()));
     };
     line({0, yo, 0}, {0, yo, top});             // the arm
     line({0, yo, top}, {-0.9, yo, top});        // the beam to the carriage

@@ -166,26 +166,10 @@ class TerrainNodelet : public nodelet::Nodelet {
 
   // --- display
 
-  static geometry_msgs::Point P(double x, double y, double z) {
-    geometry_msgs::Point p;
-    p.x = x;
-    p.y = y;
-    p.z = z;
-    return p;
-  }
 
   visualization_msgs::Marker Marker(const std::string& ns, int type, float r, float g, float b, float a) const {
-    visualization_msgs::Marker m;
+    visualization_msgs::Marker m = ColouredMarker(ns, type, r, g, b, a);
     m.header.frame_id = frame_id_;
-    m.ns = ns;
-    m.type = type;
-    m.action = visualization_msgs::Marker::ADD;
-    m.pose.orientation.w = 1.0;
-    m.scale.x = m.scale.y = m.scale.z = 1.0;
-    m.color.r = r;
-    m.color.g = g;
-    m.color.b = b;
-    m.color.a = a;
     return m;
   }
 
@@ -220,7 +204,7 @@ class TerrainNodelet : public nodelet::Nodelet {
             const double a = 2.0 * M_PI * j / n, u = r * std::cos(a), v = r * std::sin(a);
             const Eigen::Vector3d q = plane == 0 ? Eigen::Vector3d(u, v, 0) : plane == 1 ? Eigen::Vector3d(u, 0, v)
                                                                                          : Eigen::Vector3d(0, u, v);
-            sphere.points.push_back(P(c.x() + q.x(), c.y() + q.y(), c.z() + q.z()));
+            sphere.points.push_back(MakePoint(c.x() + q.x(), c.y() + q.y(), c.z() + q.z()));
           }
       arr->markers.push_back(sphere);
       // the box that follows the vehicle: its twelve edges
@@ -229,18 +213,18 @@ class TerrainNodelet : public nodelet::Nodelet {
       const double xs[2] = {d.box_rear, d.box_front}, ys[2] = {y0, y1}, zs[2] = {z0, z1};
       for (int a = 0; a < 2; ++a)
         for (int b = 0; b < 2; ++b) {
-          box.points.push_back(P(xs[0], ys[a], zs[b]));
-          box.points.push_back(P(xs[1], ys[a], zs[b]));
-          box.points.push_back(P(xs[a], ys[0], zs[b]));
-          box.points.push_back(P(xs[a], ys[1], zs[b]));
-          box.points.push_back(P(xs[a], ys[b], zs[0]));
-          box.points.push_back(P(xs[a], ys[b], zs[1]));
+          box.points.push_back(MakePoint(xs[0], ys[a], zs[b]));
+          box.points.push_back(MakePoint(xs[1], ys[a], zs[b]));
+          box.points.push_back(MakePoint(xs[a], ys[0], zs[b]));
+          box.points.push_back(MakePoint(xs[a], ys[1], zs[b]));
+          box.points.push_back(MakePoint(xs[a], ys[b], zs[0]));
+          box.points.push_back(MakePoint(xs[a], ys[b], zs[1]));
         }
       arr->markers.push_back(box);
       // the emitter's zone: the layer being filled, floor to the prepared surface
       auto emitter = Marker("patch_emitter", visualization_msgs::Marker::CUBE, 1.0f, 0.55f, 0.0f, 0.45f);
       const double ztop = surface_z_;
-      emitter.pose.position = P(0.5 * (d.emitter_from + d.emitter_to), 0.0, 0.5 * (z0 + ztop));
+      emitter.pose.position = MakePoint(0.5 * (d.emitter_from + d.emitter_to), 0.0, 0.5 * (z0 + ztop));
       emitter.scale.x = std::max(d.emitter_to - d.emitter_from, 0.02);
       emitter.scale.y = d.box_width;
       emitter.scale.z = std::max(ztop - z0, 0.02);
@@ -266,7 +250,7 @@ class TerrainNodelet : public nodelet::Nodelet {
     for (const auto& f : mesh.faces)
       for (int k = 0; k < 3; ++k) {
         const Eigen::Vector3d& v = mesh.vertices[f[k]];
-        m.points.push_back(P(v.x(), v.y(), v.z()));
+        m.points.push_back(MakePoint(v.x(), v.y(), v.z()));
         lo = lo.cwiseMin(v);
         hi = hi.cwiseMax(v);
       }
@@ -276,8 +260,8 @@ class TerrainNodelet : public nodelet::Nodelet {
     auto l = Marker("terrain_lines", visualization_msgs::Marker::LINE_LIST, 0.9f, 0.9f, 0.9f, particles ? 0.5f : 1.0f);
     l.scale.x = 0.05;
     for (double x = std::ceil(lo.x() / 5.0) * 5.0; x <= hi.x(); x += 5.0) {
-      l.points.push_back(P(x, lo.y(), hi.z() + 0.005));
-      l.points.push_back(P(x, hi.y(), hi.z() + 0.005));
+      l.points.push_back(MakePoint(x, lo.y(), hi.z() + 0.005));
+      l.points.push_back(MakePoint(x, hi.y(), hi.z() + 0.005));
     }
     arr.markers.push_back(l);
     markers_.publish(arr);

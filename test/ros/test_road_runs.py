@@ -11,15 +11,15 @@ with the file and key.
 import os
 import shutil
 import signal
-import socket
 import subprocess
-import sys
 import tempfile
 import time
 import unittest
 
 import rosbag
 import yaml
+
+from launch_run import LaunchRun  # beside this file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -28,49 +28,15 @@ RUNNER = os.environ.get('DM_RUN_SCENE', os.path.join(ROOT, 'build', 'core', 'src
 NS = '/mobility/'
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(('localhost', 0))
-        return s.getsockname()[1]
-
-
-class Run:
-    """One roslaunch of road_slope.launch with its own master, in its own folder."""
+class Run(LaunchRun):
+    """One roslaunch of road_slope.launch (or `launch`) with its own master, in its own folder; its
+    messages are compared raw."""
 
     def __init__(self, tmp, name, *args, launch='road_slope.launch'):
-        self.dir = os.path.join(tmp, name)
-        os.makedirs(self.dir)
-        self.bag = os.path.join(self.dir, 'run.bag')
-        self.result_file = os.path.join(self.dir, 'run.result.yaml')
-        self.port = free_port()
-        env = dict(os.environ, ROS_HOME=self.dir, ROS_MASTER_URI='http://localhost:%d' % self.port)
-        self.log = open(os.path.join(self.dir, 'roslaunch.log'), 'w')
-        self.proc = subprocess.Popen(['roslaunch', '-p', str(self.port), 'dem_mobility', launch,
-                                      'bag:=' + self.bag] + list(args),
-                                     stdout=self.log, stderr=subprocess.STDOUT, env=env,
-                                     start_new_session=True)
-        self.env = env
-
-    def wait(self, timeout):
-        try:
-            self.proc.wait(timeout)
-        except subprocess.TimeoutExpired:
-            os.killpg(self.proc.pid, signal.SIGKILL)
-            raise AssertionError('roslaunch did not end within %d s (log %s)' % (timeout, self.log.name))
-        self.log.close()
-        return self
-
-    def output(self):
-        with open(self.log.name) as f:
-            return f.read()
-
-    def result(self):
-        with open(self.result_file) as f:
-            return yaml.safe_load(f)
+        super().__init__(tmp, name, launch, *args)
 
     def messages(self, topics=None):
-        with rosbag.Bag(self.bag) as b:
-            return [(t, raw[1], stamp) for t, raw, stamp in b.read_messages(topics=topics, raw=True)]
+        return super().messages(topics, raw=True)
 
 
 class RoadRuns(unittest.TestCase):

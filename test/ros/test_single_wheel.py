@@ -9,42 +9,21 @@ with the scene file and the key in the log and the result YAML (status error).
 import math
 import os
 import shutil
-import signal
-import socket
-import subprocess
 import tempfile
 import unittest
 
 import rosbag
 import yaml
 
+from launch_run import LaunchRun  # beside this file
+
 NS = '/wheel/'
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(('localhost', 0))
-        return s.getsockname()[1]
 
 
 def run(tmp, name, *args, timeout=150):
     """One roslaunch of single_wheel.launch; returns (returncode, log text, bag path)."""
-    d = os.path.join(tmp, name)
-    os.makedirs(d)
-    bag = os.path.join(d, 'run.bag')
-    port = free_port()
-    env = dict(os.environ, ROS_HOME=d, ROS_MASTER_URI='http://localhost:%d' % port)
-    with open(os.path.join(d, 'roslaunch.log'), 'w') as log:
-        proc = subprocess.Popen(['roslaunch', '-p', str(port), 'dem_mobility', 'single_wheel.launch',
-                                 'bag:=' + bag, 'fidelity:=tiny', 'dem_threads:=1'] + list(args),
-                                stdout=log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
-        try:
-            proc.wait(timeout)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-            raise AssertionError('roslaunch did not end within %d s (log %s)' % (timeout, log.name))
-    with open(log.name) as fh:
-        return proc.returncode, fh.read(), bag
+    r = LaunchRun(tmp, name, 'single_wheel.launch', 'fidelity:=tiny', 'dem_threads:=1', *args).wait(timeout)
+    return r.returncode, r.output(), r.bag
 
 
 def load_result(bag):

@@ -20,17 +20,15 @@ absolutely).
 """
 import math
 import os
-import re
 import shutil
-import signal
-import socket
 import subprocess
 import tempfile
 import unittest
 
 import numpy as np
-import rosbag
 import yaml
+
+from launch_run import LaunchRun  # beside this file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -39,12 +37,6 @@ NS = '/mobility/'
 SHORT = ['settle_time:=0.2', 'duration:=0.2', 'cloud_rate:=10']
 # the keys that hold wall-clock times (they differ from run to run)
 WALL_KEYS = {'wall_time', 'real_time_factor', 'soil_prepare_wall_time', 'soil_advance_wall_time'}
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(('localhost', 0))
-        return s.getsockname()[1]
 
 
 def tiny_scene(tmp):
@@ -61,50 +53,17 @@ def tiny_scene(tmp):
     return scene
 
 
-class Run:
+class Run(LaunchRun):
     """One roslaunch of soil_slope.launch with its own master, in its own folder."""
 
     def __init__(self, tmp, name, *args):
-        self.dir = os.path.join(tmp, name)
-        os.makedirs(self.dir)
-        self.bag = os.path.join(self.dir, 'run.bag')
-        port = free_port()
         # on a shared machine, OpenMP threads that sleep at their barriers instead of spinning keep
         # an oversubscribed 2-thread soil from crawling (the results do not depend on it)
-        env = dict(os.environ, ROS_HOME=self.dir, ROS_MASTER_URI='http://localhost:%d' % port,
-                   OMP_WAIT_POLICY='PASSIVE')
-        self.log = open(os.path.join(self.dir, 'roslaunch.log'), 'w')
-        self.proc = subprocess.Popen(['roslaunch', '-p', str(port), 'dem_mobility', 'soil_slope.launch',
-                                      'bag:=' + self.bag] + list(args),
-                                     stdout=self.log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
-
-    def wait(self, timeout):
-        try:
-            self.proc.wait(timeout)
-        except subprocess.TimeoutExpired:
-            os.killpg(self.proc.pid, signal.SIGKILL)
-            raise AssertionError('roslaunch did not end within %d s (log %s)' % (timeout, self.log.name))
-        finally:
-            self.log.close()
-        return self
-
-    def output(self):
-        with open(self.log.name) as f:
-            return f.read()
-
-    def result(self):
-        with open(self.bag[:-4] + '.result.yaml') as f:
-            return yaml.safe_load(f)
+        super().__init__(tmp, name, 'soil_slope.launch', *args, env={'OMP_WAIT_POLICY': 'PASSIVE'})
 
     def result_keys(self):
-        with open(self.bag[:-4] + '.result.yaml') as f:
+        with open(self.result_file) as f:
             return [line.split(':')[0] for line in f if line[:1].isalpha()]
-
-    def messages(self, raw=False):
-        with rosbag.Bag(self.bag) as b:
-            if raw:
-                return [(t, m[1], s) for t, m, s in b.read_messages(raw=True)]
-            return [(t, m, s) for t, m, s in b.read_messages()]
 
 
 class SoilSlopeRuns(unittest.TestCase):

@@ -29,6 +29,13 @@ void ToPointCloud(const DemSystem& s, sensor_msgs::PointCloud2* cloud,
 /// state it was laid down with. In ID order.
 void ToPointCloud(const DemSystem& s, std::vector<float>* first_shown, sensor_msgs::PointCloud2* cloud);
 
+/// A point message.
+geometry_msgs::Point MakePoint(double x, double y, double z);
+
+/// An empty marker of namespace `ns` and `type` (visualization_msgs::Marker::LINE_LIST, ...) in
+/// colour (r, g, b, a), at the identity pose, unit scale, action ADD; the frame is left to the caller.
+visualization_msgs::Marker ColouredMarker(const std::string& ns, int type, float r, float g, float b, float a);
+
 /// One wall as a TRIANGLE_LIST marker in its body frame, posed at the wall's pose.
 visualization_msgs::Marker WallMarker(const DemWall& w, const std::string& ns, int id, float r, float g, float b,
                                       float a);

@@ -293,7 +293,8 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   }
   // what left the sphere, and strays in the emitter's zone, in storage order (the same for any
   // thread count)
-  std::vector<int> out;
+  std::vector<int>& out = leaving_;
+  out.clear();
   const double r2 = radius_ * radius_;
   const bool emitting = layer_ >= 0;
   const double zone_from = emitter_from() - 0.25 * d_, zone_to = emitter_to() + d_;

@@ -117,6 +117,7 @@ class SoilPatch {
   int layer_ = -1;                   ///< the layer being filled
   std::vector<int> free_;            ///< its free sites, lowest first
   std::vector<Eigen::Vector3d> zone_;  ///< particles near the layer being filled
+  std::vector<int> leaving_;         ///< this step's particles to re-emit (kept: no allocation per step)
   int prev_layer_first_id_ = 0, layer_first_id_ = 0;
   bool started_ = false;
   double tool_offset_ = 0.0;         ///< leveling cylinder x - sphere centre x

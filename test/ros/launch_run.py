@@ -1,0 +1,65 @@
+"""One roslaunch of a dem_mobility launch file as a user starts it, with its own master on a free
+port and its own folder (ROS_HOME, the log, the bag and the result YAML beside it): what the
+end-to-end tests under test/ros share."""
+import os
+import signal
+import socket
+import subprocess
+
+import rosbag
+import yaml
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(('localhost', 0))
+        return s.getsockname()[1]
+
+
+class LaunchRun:
+    """`roslaunch dem_mobility LAUNCH bag:=DIR/run.bag ARGS...` in DIR = tmp/name; the run's result
+    YAML is the bag's name with .result.yaml. `env` adds to the environment."""
+
+    def __init__(self, tmp, name, launch, *args, env=None):
+        self.dir = os.path.join(tmp, name)
+        os.makedirs(self.dir)
+        self.bag = os.path.join(self.dir, 'run.bag')
+        self.result_file = self.bag[:-4] + '.result.yaml'
+        self.port = free_port()
+        self.env = dict(os.environ, ROS_HOME=self.dir, ROS_MASTER_URI='http://localhost:%d' % self.port,
+                        **(env or {}))
+        self.log = open(os.path.join(self.dir, 'roslaunch.log'), 'w')
+        self.proc = subprocess.Popen(['roslaunch', '-p', str(self.port), 'dem_mobility', launch,
+                                      'bag:=' + self.bag] + list(args),
+                                     stdout=self.log, stderr=subprocess.STDOUT, env=self.env,
+                                     start_new_session=True)
+
+    def wait(self, timeout):
+        """Waits for roslaunch to end (killing its process group after `timeout` s: an error)."""
+        try:
+            self.proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+            raise AssertionError('roslaunch did not end within %d s (log %s)' % (timeout, self.log.name))
+        finally:
+            self.log.close()
+        return self
+
+    @property
+    def returncode(self):
+        return self.proc.returncode
+
+    def output(self):
+        with open(self.log.name) as f:
+            return f.read()
+
+    def result(self):
+        with open(self.result_file) as f:
+            return yaml.safe_load(f)
+
+    def messages(self, topics=None, raw=False):
+        """(topic, message, stamp) of every message in the bag; raw: the serialized bytes instead."""
+        with rosbag.Bag(self.bag) as b:
+            if raw:
+                return [(t, m[1], s) for t, m, s in b.read_messages(topics=topics, raw=True)]
+            return [(t, m, s) for t, m, s in b.read_messages(topics=topics)]
