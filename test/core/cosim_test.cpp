@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -206,6 +207,37 @@ TEST(SteadyWindow, MeansOverTheWindowAndTheDrawbarMarginBeyondTheGrade) {
   EXPECT_NEAR(f.traction_coefficient, 12000.0 / wn, 1e-12);
   EXPECT_NEAR(f.motion_resistance, 3000.0 / wn, 1e-12);
   EXPECT_NEAR(f.drawbar_margin, 12000.0 / wn - std::tan(grade * M_PI / 180.0), 1e-12);
+}
+
+// A stall is the speed under stall_speed for stall_time on end while the command asks for more:
+// a slow start, or a vehicle that slows down for a moment, is not one.
+TEST(SpeedMadeGood, NoGoOnlyAfterAWholeStallWhileTheCommandAsksForMore) {
+  const PlateauParams p;  // 0.2 m/s for 5 s
+  // 100 Hz samples to t_end; speed(t), command 1 m/s^2
+  auto history = [](double t_end, const std::function<double(double)>& speed) {
+    std::vector<MobilitySample> h;
+    for (int k = 0; k * 0.01 <= t_end + 1e-9; ++k) {
+      const double t = 0.01 * k;
+      h.push_back(MobilitySample{t, 0.0, speed(t), t, 0.0, 0.0, 0.0, true});
+    }
+    return h;
+  };
+  // crawling for 4.3 s from the start, then moving: no stall
+  const auto slow_start = history(10.0, [](double t) { return t < 4.3 ? 0.1 : 3.0; });
+  EXPECT_EQ(StalledFor(slow_start, p.stall_speed), 0.0);
+  EXPECT_NE(DetectSpeedMadeGood(slow_start, p, 25.0).status, "no_go");
+  // moving, then under 0.2 m/s from t = 7.5: stalled for 1.2 s at 8.7 s (no verdict yet), for
+  // 5 s at 12.5 s (no-go)
+  const auto slows = [](double t) { return t < 7.5 ? 6.0 : 0.1; };
+  EXPECT_NEAR(StalledFor(history(8.7, slows), p.stall_speed), 1.2, 0.011);
+  EXPECT_NE(DetectSpeedMadeGood(history(8.7, slows), p, 25.0).status, "no_go");
+  EXPECT_NEAR(StalledFor(history(12.5, slows), p.stall_speed), 5.0, 0.011);
+  EXPECT_EQ(DetectSpeedMadeGood(history(12.6, slows), p, 25.0).status, "no_go");
+  // never moving: stalled from when the command passed 0.2 m/s (t = 0.2 s)
+  const auto never = history(5.3, [](double) { return 0.0; });
+  EXPECT_NEAR(StalledFor(never, p.stall_speed), 5.1, 0.011);
+  EXPECT_EQ(DetectSpeedMadeGood(never, p, 25.0).status, "no_go");
+  EXPECT_NE(DetectSpeedMadeGood(history(5.1, [](double) { return 0.0; }), p, 25.0).status, "no_go");
 }
 
 TEST(VehicleCoSim, EndsWhenSteadyIfAskedWithTheSpeedOfTheFullRun) {

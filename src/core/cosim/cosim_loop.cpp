@@ -74,7 +74,7 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
         }
         if (k % sample_every == 0) {
           r.history.push_back(Sample(sim, t, veh.ChassisFramePosition().x() - x0, cmd));
-          if (t >= p.plateau.stall_time && v < p.plateau.stall_speed && cmd.speed_command > p.plateau.stall_speed) {
+          if (v < p.plateau.stall_speed && StalledFor(r.history, p.plateau.stall_speed) >= p.plateau.stall_time) {
             r.ended_early = true;
             break;
           }

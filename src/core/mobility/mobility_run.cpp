@@ -46,6 +46,13 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
   return p;
 }
 
+double StalledFor(const std::vector<MobilitySample>& h, double stall_speed) {
+  if (h.empty()) return 0.0;
+  for (auto it = h.rbegin(); it != h.rend(); ++it)
+    if (it->speed >= stall_speed || it->speed_command <= stall_speed) return h.back().t - it->t;
+  return h.back().t - h.front().t;
+}
+
 SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const PlateauParams& p, double v_max) {
   SpeedMadeGood s;
   if (h.empty()) {
@@ -53,7 +60,7 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
     return s;
   }
   const double t_end = h.back().t;
-  if (t_end >= p.stall_time && h.back().speed < p.stall_speed) {
+  if (StalledFor(h, p.stall_speed) >= p.stall_time) {
     s.status = "no_go";
     return s;
   }

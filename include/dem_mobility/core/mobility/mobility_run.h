@@ -23,7 +23,7 @@ class TerrainModel;
 struct PlateauParams {
   double window = 5.0;        ///< [s] trailing window the steady state is judged on
   double tolerance = 0.05;    ///< [m/s^2] largest |dv/dt| in the window that counts as steady
-  double stall_speed = 0.2;   ///< [m/s] below this after stall_time: no-go
+  double stall_speed = 0.2;   ///< [m/s] below this for stall_time (while the command is above it): no-go
   double stall_time = 5.0;    ///< [s]
 };
 
@@ -65,7 +65,13 @@ struct SpeedMadeGood {
   double window_std = 0.0;  ///< speed standard deviation in the window [m/s]
 };
 
-/// Judges the speed history: a plateau under full throttle, the command reached, or a stall.
+/// How long the vehicle has been stalled at the end of the history [s]: the time since the last
+/// sample at which it moved at `stall_speed` or more, or at which the command was not above
+/// `stall_speed` yet (a vehicle the driver has not asked to move is not stuck); 0 if it moves now.
+double StalledFor(const std::vector<MobilitySample>& h, double stall_speed);
+
+/// Judges the speed history: a plateau under full throttle, the command reached, or a stall
+/// (stalled for `stall_time`: no-go).
 SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const PlateauParams& p, double v_max);
 
 /// Means over the detector's judging window (the steady state).
