@@ -88,6 +88,8 @@ void ToMsg(const core::DriverInput& in, dem_mobility::DriverInput* m) {
   m->period = in.period;
   m->forward_speed = in.forward_speed;
   m->drive_shaft_speed = in.drive_shaft_speed;
+  m->lateral_offset = in.lateral_offset;
+  m->heading = in.heading;
 }
 
 core::DriverInput FromMsg(const dem_mobility::DriverInput& m) {
@@ -97,6 +99,8 @@ core::DriverInput FromMsg(const dem_mobility::DriverInput& m) {
   in.period = m.period;
   in.forward_speed = m.forward_speed;
   in.drive_shaft_speed = m.drive_shaft_speed;
+  in.lateral_offset = m.lateral_offset;
+  in.heading = m.heading;
   return in;
 }
 
@@ -105,7 +109,7 @@ void ToMsg(const core::DriverCommand& c, dem_mobility::DriverCommand* m) {
   m->torque_request = c.torque_request;
   m->drive_torque = c.drive_torque;
   m->brake_effort = c.brake_effort;
-  m->steering = 0.0;
+  m->steering = c.steering;
   m->wot_limited = c.wot_limited;
 }
 
@@ -115,6 +119,7 @@ core::DriverCommand FromMsg(const dem_mobility::DriverCommand& m) {
   c.torque_request = m.torque_request;
   c.drive_torque = m.drive_torque;
   c.brake_effort = m.brake_effort;
+  c.steering = m.steering;
   c.wot_limited = m.wot_limited;
   return c;
 }

@@ -237,7 +237,30 @@ TEST(SpeedMadeGood, NoGoOnlyAfterAWholeStallWhileTheCommandAsksForMore) {
   const auto never = history(5.3, [](double) { return 0.0; });
   EXPECT_NEAR(StalledFor(never, p.stall_speed), 5.1, 0.011);
   EXPECT_EQ(DetectSpeedMadeGood(never, p, 25.0).status, "no_go");
-  EXPECT_NE(DetectSpeedMadeGood(history(5.1, [](double) { return 0.0; }), p, 25.0).status, "no_go");
+  // at 5.1 s (stalled for 4.9 s) not yet no-go, and no plateau either: a flat speed under 0.2 m/s
+  // is a stall in the making
+  EXPECT_EQ(DetectSpeedMadeGood(history(5.1, [](double) { return 0.0; }), p, 25.0).status, "not_steady");
+}
+
+// A plateau is a flat and quiet window: a speed that rises and falls within the window fits a
+// flat line but is no plateau; a flat speed with DEM-like noise is one.
+TEST(SpeedMadeGood, SteadyIsFlatAndQuietNotARiseAndFall) {
+  const PlateauParams p;  // 5 s window, |slope| <= 0.05 m/s^2, rms about the line <= 10 % of the mean
+  auto history = [](const std::function<double(double)>& speed) {
+    std::vector<MobilitySample> h;
+    for (int k = 0; k <= 900; ++k) h.push_back(MobilitySample{0.01 * k, 0.0, speed(0.01 * k), 0.01 * k, 0.0, 0.0,
+                                                              0.0, true});
+    return h;
+  };
+  // 2 -> 6 m/s over 4 -> 7.5 s, then down to ~1 m/s at 9 s (the soil gave way): slope about 0
+  const auto rise_fall = history([](double t) { return t < 4.0 ? 2.0 : t < 7.5 ? 2.0 + 4.0 * (t - 4.0) / 3.5 : 6.0 - 3.4 * (t - 7.5); });
+  const SpeedMadeGood rf = DetectSpeedMadeGood(rise_fall, p, 25.0);
+  EXPECT_LT(std::abs(rf.window_slope), 0.3);
+  EXPECT_EQ(rf.status, "not_steady");
+  // 4 m/s with +-0.3 m/s of noise (a 7 Hz wobble, rms 0.21 m/s: 5 % of the mean): steady at 4
+  const SpeedMadeGood flat = DetectSpeedMadeGood(history([](double t) { return 4.0 + 0.3 * std::sin(44.0 * t); }), p, 25.0);
+  EXPECT_EQ(flat.status, "steady");
+  EXPECT_NEAR(flat.value, 4.0, 0.02);
 }
 
 TEST(VehicleCoSim, EndsWhenSteadyIfAskedWithTheSpeedOfTheFullRun) {

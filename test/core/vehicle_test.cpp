@@ -150,8 +150,8 @@ TEST(Vehicle, SteadySpeedOnAGradeMatchesThePowerBalance) {
 // limits).
 TEST(Vehicle, ClimbsThirtyDegreesAtThePowerBalanceSpeedWithTheCentreLocked) {
   const double grade = 30.0;
-  MobilityRunParams p = Scene(grade);
-  p.duration = 22.0;
+  MobilityRunParams p = Scene(grade);  // 40 s, the driver keeping to the start line
+  ASSERT_TRUE(p.driver.steer);
   MobilityRun s(p);
   ASSERT_EQ(s.vehicle().spec().driveline.centre_differential, Differential::kLocked);  // the shipped file
   const MobilityRunResult r = s.Run();
@@ -163,6 +163,28 @@ TEST(Vehicle, ClimbsThirtyDegreesAtThePowerBalanceSpeedWithTheCentreLocked) {
                                             v.driveline_reduction(), grade * M_PI / 180.0, c_rr);
   EXPECT_NEAR(r.smg.value, expected, 0.05 * expected);
   EXPECT_TRUE(r.history.back().wot_limited);
+  // on its line the whole way: within a quarter of a tire's width of it, heading within 1 deg
+  double y = 0.0, heading = 0.0;
+  for (const MobilitySample& h : r.history) {
+    y = std::max(y, std::abs(h.y));
+    heading = std::max(heading, std::abs(h.heading));
+  }
+  EXPECT_LT(y, 0.25 * v.tire().width);
+  EXPECT_LT(heading, M_PI / 180.0);
+}
+
+// Without the driver's steering the rigid tires' lateral forces (the wheels toe under load) turn
+// the vehicle off its line on 30 deg; it leaves the 8 m road and the run stops with an error that
+// names the road and its width instead of going on off the road.
+TEST(Vehicle, UnsteeredOnThirtyDegreesItLeavesTheRoadAndTheRunStopsSayingSo) {
+  MobilityRunParams p = Scene(30.0);
+  p.driver.steer = false;
+  const MobilityRunResult r = MobilityRun(p).Run();
+  EXPECT_NE(r.error.find("off the road"), std::string::npos) << r.error;
+  EXPECT_NE(r.error.find("`width`"), std::string::npos) << r.error;
+  EXPECT_NE(r.error.find("rigid_road.yaml"), std::string::npos) << r.error;
+  ASSERT_FALSE(r.history.empty());
+  EXPECT_GT(std::abs(r.history.back().y), 2.0);  // drifted sideways by metres before it stopped
 }
 
 // With an open centre differential the drive shaft gives both axles the same torque, so the front

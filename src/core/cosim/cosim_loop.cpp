@@ -10,9 +10,10 @@ namespace dem_mobility::core {
 
 namespace {
 
-MobilitySample Sample(const VehicleCoSim& sim, double t, double x, const DriverCommand& cmd) {
+MobilitySample Sample(const VehicleCoSim& sim, double t, const Eigen::Vector3d& from, const DriverCommand& cmd) {
   const Vehicle& veh = sim.vehicle();
-  MobilitySample s{t, x, veh.ForwardSpeed(), cmd.speed_command, veh.DriveShaftSpeed(), veh.AppliedDriveTorque(),
+  const Eigen::Vector3d at = veh.ChassisFramePosition() - from;
+  MobilitySample s{t, at.x(), veh.ForwardSpeed(), cmd.speed_command, veh.DriveShaftSpeed(), veh.AppliedDriveTorque(),
                    cmd.brake_effort, cmd.wot_limited};
   const double r = veh.tire().radius;
   for (int i = 0; i < kWheels; ++i) {
@@ -24,6 +25,9 @@ MobilitySample Sample(const VehicleCoSim& sim, double t, double x, const DriverC
     s.traction += f.force.x();
   }
   s.thrust = veh.AppliedDriveTorque() / veh.driveline_reduction() / r;
+  s.y = at.y();
+  const Eigen::Vector3d ax = veh.system().body(veh.chassis()).R.col(0);
+  s.heading = std::atan2(ax.y(), ax.x());
   return s;
 }
 
@@ -48,7 +52,7 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
   const long control_every = std::max(1L, std::lround(p.driver.control_period / dt));
   DriverCommand cmd;
   cmd.brake_effort = 1.0;  // settling: brakes on, no drive
-  double x0 = 0.0;
+  Eigen::Vector3d p0 = Eigen::Vector3d::Zero();  // the chassis frame at the driver's start
   try {
     veh.SetBrakeEffort(cmd.brake_effort);
     veh.SetDriveTorqueRequest(0.0);
@@ -56,7 +60,7 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
     for (;;) {
       const long k = sim.step() - drive_step;  // steps since the driver's start
       if (k >= 0) {
-        if (k == 0) x0 = veh.ChassisFramePosition().x();
+        if (k == 0) p0 = veh.ChassisFramePosition();
         const double t = k * dt;
         const double v = veh.ForwardSpeed();
         const double w_ds = veh.DriveShaftSpeed();
@@ -67,13 +71,17 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
           in.period = control_every * dt;
           in.forward_speed = v;
           in.drive_shaft_speed = w_ds;
+          const Eigen::Vector3d ax = veh.system().body(veh.chassis()).R.col(0);
+          in.lateral_offset = veh.ChassisFramePosition().y() - p0.y();
+          in.heading = std::atan2(ax.y(), ax.x());
           cmd = driver.Exchange(in);
           ++r.driver_updates;
           veh.SetDriveTorqueRequest(cmd.drive_torque);
           veh.SetBrakeEffort(cmd.brake_effort);
+          veh.SetSteering(cmd.steering);
         }
         if (k % sample_every == 0) {
-          r.history.push_back(Sample(sim, t, veh.ChassisFramePosition().x() - x0, cmd));
+          r.history.push_back(Sample(sim, t, p0, cmd));
           if (v < p.plateau.stall_speed && StalledFor(r.history, p.plateau.stall_speed) >= p.plateau.stall_time) {
             r.ended_early = true;
             break;

@@ -14,12 +14,22 @@ void LocalTerrainPort::Exchange(long step, double t, double dt, const std::vecto
 
 const TerrainDescription& LocalTerrainPort::description() const { return model_.description(); }
 
+namespace {
+DriverParams WithWheelbase(DriverParams p, const VehicleSpec& vehicle) {
+  p.wheelbase = vehicle.wheelbase;
+  return p;
+}
+}  // namespace
+
 SceneDriver::SceneDriver(const DriverParams& p, const VehicleSpec& vehicle)
     : powertrain_(vehicle.powertrain),
-      driver_(p, powertrain_, vehicle.TotalMass(), vehicle.wheel_radius(), vehicle.driveline_reduction()) {}
+      driver_(WithWheelbase(p, vehicle), powertrain_, vehicle.TotalMass(), vehicle.wheel_radius(),
+              vehicle.driveline_reduction()) {}
 
 DriverCommand SceneDriver::Exchange(const DriverInput& in) {
-  return driver_.Update(in.time, in.period, in.forward_speed, in.drive_shaft_speed);
+  DriverCommand c = driver_.Update(in.time, in.period, in.forward_speed, in.drive_shaft_speed);
+  c.steering = driver_.Steering(in.lateral_offset, in.heading, in.forward_speed);
+  return c;
 }
 
 }  // namespace dem_mobility::core

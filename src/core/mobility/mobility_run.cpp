@@ -38,6 +38,7 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
   p.sample_rate = res.DoubleIn("sample_rate", 1.0, 1e5, 100.0);
   p.plateau.window = res.DoubleIn("plateau_window", 0.5, 60.0, 5.0);
   p.plateau.tolerance = res.Positive("plateau_tolerance", 0.05);
+  p.plateau.scatter = res.Positive("plateau_scatter", 0.1);
   p.plateau.stall_speed = res.Positive("stall_speed", 0.2);
   p.plateau.stall_time = res.Positive("stall_time", 5.0);
   p.end_when_steady = res.Bool("end_when_steady", false);
@@ -80,10 +81,12 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
   const double var_t = stt / n - (st / n) * (st / n);
   s.window_slope = var_t > 0 ? (stv / n - (st / n) * mean) / var_t : 0.0;
   s.window_std = std::sqrt(std::max(0.0, svv / n - mean * mean));
+  // the scatter about the fitted line: a rise and a fall within the window fit a flat line too
+  const double residual = std::sqrt(std::max(0.0, svv / n - mean * mean - s.window_slope * s.window_slope * var_t));
   s.value = mean;
-  if (t_end < p.window) {
+  if (t_end < p.window || mean < p.stall_speed) {  // (under the stall speed: a stall, if it lasts)
     s.status = "not_steady";
-  } else if (std::abs(s.window_slope) > p.tolerance) {
+  } else if (std::abs(s.window_slope) > p.tolerance || residual > p.scatter * std::abs(mean)) {
     s.status = "not_steady";
   } else if (!limited && mean >= 0.98 * v_max) {
     s.status = "command_limited";
@@ -165,13 +168,14 @@ ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParam
 void WriteMobilityHistory(const MobilityRunResult& r, const std::string& path) {
   std::ofstream out(path);
   if (!out) throw ConfigError(path + ": cannot write the history file");
-  out << "t,x,speed,speed_command,drive_shaft_speed,drive_torque,brake_effort,wot_limited,traction,thrust";
+  out << "t,x,speed,speed_command,drive_shaft_speed,drive_torque,brake_effort,wot_limited,traction,thrust,y,heading";
   for (const char* w : kWheelNames) out << ",slip_" << w;
   for (const char* w : kWheelNames) out << ",sinkage_" << w;
   out << "\n" << std::setprecision(8);
   for (const auto& s : r.history) {
     out << s.t << "," << s.x << "," << s.speed << "," << s.speed_command << "," << s.drive_shaft_speed << ","
-        << s.drive_torque << "," << s.brake_effort << "," << s.wot_limited << "," << s.traction << "," << s.thrust;
+        << s.drive_torque << "," << s.brake_effort << "," << s.wot_limited << "," << s.traction << "," << s.thrust
+        << "," << s.y << "," << s.heading;
     for (double v : s.slip) out << "," << v;
     for (double v : s.sinkage) out << "," << v;
     out << "\n";

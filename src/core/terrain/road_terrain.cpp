@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
@@ -17,6 +18,8 @@ class RoadTerrain final : public TerrainModel {
     description_ = DescribeRoadTerrain(y);
     const double length = y.Positive("length");
     const double width = y.DoubleIn("width", 3.0, 1000.0);
+    half_width_ = 0.5 * width;
+    file_ = y.file();
     const double cell = y.Positive("cell");
     const double start = y.Double("start_x");
     const YamlReader c = y.Child("contact");
@@ -49,6 +52,11 @@ class RoadTerrain final : public TerrainModel {
     DM_THROW_UNLESS(states.size() == kWheels, "rigid_road: expected ", kWheels, " wheel states, got ", states.size());
     for (int i = 0; i < kWheels; ++i) {
       const WheelState& s = states[i];
+      // a wheel past the road's edge is off the road: the run cannot go on as a run on this road
+      if (std::abs(s.position.y()) > half_width_)
+        throw SimulationError(detail::Concat("rigid_road (", file_, "): wheel ", kWheelNames[i], " is at y = ",
+                                             s.position.y(), " m, off the road (", 2.0 * half_width_,
+                                             " m wide, `width`): the vehicle veered off its course"));
       RigidBody& b = bodies_[i];
       b.x = s.position;
       b.R = s.orientation.toRotationMatrix();
@@ -77,7 +85,8 @@ class RoadTerrain final : public TerrainModel {
   Bodies bodies_;  ///< one stand-in body per wheel, holding the exchanged state
   TireContact tires_[kWheels];
   std::vector<WheelWrench> wrenches_;
-  double stiffness_ = 0.0, damping_ = 0.0;
+  double stiffness_ = 0.0, damping_ = 0.0, half_width_ = 0.0;
+  std::string file_;
 };
 
 }  // namespace

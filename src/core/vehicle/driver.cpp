@@ -16,6 +16,14 @@ DriverParams DriverParams::Read(const YamlReader& y) {
   p.ki = y.NonNegative("ki");
   p.full_throttle = y.Bool("full_throttle", false);
   p.control_period = y.DoubleIn("control_period", 1e-7, 0.1, 1e-3);
+  if (y.Has("steering")) {
+    const YamlReader s = y.Child("steering");
+    p.steer = true;
+    p.lookahead_time = s.NonNegative("lookahead_time");
+    p.lookahead_min = s.DoubleIn("lookahead_min", 0.1, 1000.0);
+    p.full_lock = s.DoubleIn("full_lock_deg", 1.0, 60.0) * M_PI / 180.0;
+    s.Finish();
+  }
   y.Finish();
   return p;
 }
@@ -23,6 +31,17 @@ DriverParams DriverParams::Read(const YamlReader& y) {
 SpeedDriver::SpeedDriver(const DriverParams& p, const PowertrainParams& pt, double vehicle_mass,
                          double wheel_radius, double reduction)
     : p_(p), pt_(pt), mass_(vehicle_mass), radius_(wheel_radius), reduction_(reduction) {}
+
+double SpeedDriver::Steering(double y, double heading, double v) const {
+  if (!p_.steer || p_.wheelbase <= 0.0) return 0.0;
+  // pure pursuit: the arc through the vehicle and the point on the line `lookahead` ahead
+  const double l = std::max(p_.lookahead_min, p_.lookahead_time * std::abs(v));
+  // the point (x + l, 0) of the line seen from the vehicle: its lateral coordinate in the vehicle's
+  // frame (to the left +); the arc's curvature 2 lateral / l^2, the bicycle model's wheel angle
+  const double lateral = -(y * std::cos(heading) + l * std::sin(heading));
+  const double angle = std::atan(2.0 * p_.wheelbase * lateral / (l * l));
+  return std::clamp(angle / p_.full_lock, -1.0, 1.0);
+}
 
 double SpeedDriver::SpeedCommand(double t) const { return std::min(p_.v_max, p_.accel * std::max(0.0, t)); }
 

@@ -1,6 +1,7 @@
 #include "dem_mobility/core/vehicle/vehicle.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -25,6 +26,12 @@ Vector3d Vehicle::ChassisFramePosition() const {
   const RigidBody& c = system_.body(chassis_);
   return c.x - c.R * chassis_com_offset_;
 }
+void Vehicle::SetSteering(double fraction) {
+  steering_ = std::clamp(fraction, -1.0, 1.0);
+  // the rack moving to +y (the vehicle's left) turns the wheels to the right
+  if (rack_ >= 0) system_.line_constraints[rack_].target = -steering_ * spec_.steering.max_rack_travel;
+}
+
 double Vehicle::ForwardSpeed() const {
   const RigidBody& c = system_.body(chassis_);
   return c.v.dot(c.R.col(0));

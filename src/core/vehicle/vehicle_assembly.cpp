@@ -244,6 +244,7 @@ void VehicleAssembler::Steering() {
   line.drive = true;
   line.k_drive = spec_.steering.actuator.k;
   line.c_drive = spec_.steering.actuator.c;
+  vehicle_->rack_ = static_cast<int>(system_.line_constraints.size());
   system_.line_constraints.push_back(line);
   OrientationLock lock;
   lock.name = "rack_prismatic/orientation";

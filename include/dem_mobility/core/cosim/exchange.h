@@ -55,6 +55,8 @@ struct DriverInput {
   double period = 0.0;            ///< control period [s]
   double forward_speed = 0.0;     ///< [m/s]
   double drive_shaft_speed = 0.0; ///< [rad/s]
+  double lateral_offset = 0.0;    ///< [m] the chassis frame from the start line (the x axis), + left
+  double heading = 0.0;           ///< [rad] the chassis x axis's yaw from the start line, + left
 };
 
 }  // namespace dem_mobility::core

@@ -23,6 +23,7 @@ class TerrainModel;
 struct PlateauParams {
   double window = 5.0;        ///< [s] trailing window the steady state is judged on
   double tolerance = 0.05;    ///< [m/s^2] largest |dv/dt| in the window that counts as steady
+  double scatter = 0.1;       ///< largest rms speed about the window's fitted line, over its mean speed
   double stall_speed = 0.2;   ///< [m/s] below this for stall_time (while the command is above it): no-go
   double stall_time = 5.0;    ///< [s]
 };
@@ -56,6 +57,8 @@ struct MobilitySample {
   std::array<double, kWheels> sinkage{};  ///< [m] per wheel, as the terrain reports it
   double traction = 0.0;  ///< the terrain's pull on the wheels along the slope [N]
   double thrust = 0.0;    ///< drive torque at the wheels over the tire radius [N]
+  double y = 0.0;         ///< [m] the chassis frame's lateral offset from the start (+ left)
+  double heading = 0.0;   ///< [rad] the chassis x axis's yaw from the start (+ to the left)
 };
 
 struct SpeedMadeGood {

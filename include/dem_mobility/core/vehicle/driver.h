@@ -16,6 +16,13 @@ struct DriverParams {
   double ki = 0.0;            ///< integral feedback [N per m]
   bool full_throttle = false; ///< ignore the profile: request WOT all the time
   double control_period = 1e-3; ///< [s] the driver acts this often (rounded to whole vehicle steps)
+  /// Keeping to the start line (x axis) by pure pursuit of a point `lookahead` ahead on it, with
+  /// lookahead = max(lookahead_min, lookahead_time x speed); off (no steering) unless `steering:` is given.
+  bool steer = false;
+  double lookahead_time = 1.0;  ///< [s]
+  double lookahead_min = 5.0;   ///< [m]
+  double full_lock = 0.0;       ///< [rad] the wheels' angle at full lock (steering fraction 1)
+  double wheelbase = 0.0;       ///< [m] of the bicycle model the pursuit steers (from the vehicle)
   static DriverParams Read(const YamlReader& y);
 };
 
@@ -25,6 +32,7 @@ struct DriverCommand {
   double torque_request = 0.0;  ///< drive-shaft torque asked for [N m] (before the engine clamp)
   double drive_torque = 0.0;    ///< after the clamp between engine-brake and WOT curves [N m]
   double brake_effort = 0.0;    ///< [0, 1]
+  double steering = 0.0;        ///< fraction of full lock, positive to the left, [-1, 1]
   bool wot_limited = false;     ///< the request exceeds the WOT curve (full throttle)
 };
 
@@ -38,6 +46,9 @@ class SpeedDriver {
   double SpeedCommand(double t) const;
   /// Advances the controller by dt at time t with forward speed v and drive-shaft speed w_ds.
   DriverCommand Update(double t, double dt, double v, double w_ds);
+  /// The steering fraction that keeps to the start line, from the lateral offset y [m, + left]
+  /// and the heading [rad, + left] at forward speed v (0 when steering is off).
+  double Steering(double y, double heading, double v) const;
 
  private:
   DriverParams p_;

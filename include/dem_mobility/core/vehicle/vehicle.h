@@ -61,6 +61,9 @@ class Vehicle {
 
   void SetDriveTorqueRequest(double t) { drive_request_ = t; }
   void SetBrakeEffort(double effort) { brake_effort_ = effort; }
+  /// Steering: the rack's position servo to `fraction` of full lock (max_rack_travel; + left).
+  void SetSteering(double fraction);
+  double Steering() const { return steering_; }
   double AppliedDriveTorque() const;
   double BrakeEffort() const { return brake_effort_; }
 
@@ -78,7 +81,8 @@ class Vehicle {
   int drive_ = -1;                ///< index into system_.torques
   Eigen::Vector3d chassis_com_offset_ = Eigen::Vector3d::Zero();
   double ride_height_ = 0.0;
-  double drive_request_ = 0.0, brake_effort_ = 0.0;
+  double drive_request_ = 0.0, brake_effort_ = 0.0, steering_ = 0.0;
+  int rack_ = -1;                 ///< index into system_.line_constraints (the rack's prismatic joint)
   std::array<WheelWrench, 4> wrench_{};
 };
 
