@@ -1,6 +1,7 @@
 // dem_mobility/DriverNodelet: the driver side of the lock-step exchange. Answers each DriverInput
-// (speed, drive-shaft speed) with the scene driver's command (core SpeedDriver: profile, speed
-// controller, clamp between the engine-brake and WOT curves, brakes).
+// (speed, drive-shaft speed, lateral offset and heading) with the scene driver's command (core
+// SpeedDriver: profile, speed controller, clamp between the engine-brake and WOT curves, brakes,
+// steering to the start line).
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 

@@ -145,9 +145,8 @@ TEST(Vehicle, SteadySpeedOnAGradeMatchesThePowerBalance) {
 
 // The paper's driveline (one drive shaft driving both axles, centre locked) climbs a 30 deg paved
 // grade at full throttle: each axle pulls as its own load allows, so the rear axle, loaded by the
-// grade, carries what the front cannot. 22 s: the plateau from about 17 s; the heading drifts on
-// this grade and the vehicle would leave the 8 m road at about 25 s (docs/vehicle-model.md, known
-// limits).
+// grade, carries what the front cannot. The whole 40 s (the plateau from about 17 s), the driver
+// keeping to the start line (unsteered it would leave the 8 m road at about 25 s: next test).
 TEST(Vehicle, ClimbsThirtyDegreesAtThePowerBalanceSpeedWithTheCentreLocked) {
   const double grade = 30.0;
   MobilityRunParams p = Scene(grade);  // 40 s, the driver keeping to the start line
@@ -163,13 +162,13 @@ TEST(Vehicle, ClimbsThirtyDegreesAtThePowerBalanceSpeedWithTheCentreLocked) {
                                             v.driveline_reduction(), grade * M_PI / 180.0, c_rr);
   EXPECT_NEAR(r.smg.value, expected, 0.05 * expected);
   EXPECT_TRUE(r.history.back().wot_limited);
-  // on its line the whole way: within a quarter of a tire's width of it, heading within 1 deg
+  // on its line the whole way: within half a tire's width of it, heading within 1 deg
   double y = 0.0, heading = 0.0;
   for (const MobilitySample& h : r.history) {
     y = std::max(y, std::abs(h.y));
     heading = std::max(heading, std::abs(h.heading));
   }
-  EXPECT_LT(y, 0.25 * v.tire().width);
+  EXPECT_LT(y, 0.5 * v.tire().width);  // the wheels stay in their own tracks
   EXPECT_LT(heading, M_PI / 180.0);
 }
 

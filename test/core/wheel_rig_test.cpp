@@ -39,6 +39,8 @@ const DemSoilBin& Prepared(double ci) {
 struct RigRun {
   double dp_w = 0.0, dp_w_std = 0.0, sinkage = 0.0, static_force = 0.0;
   int samples = 0;
+  bool sunk = false;
+  std::string error;
 };
 
 RigRun DriveOnce(double ci, const std::string& drive, double slip) {
@@ -46,8 +48,8 @@ RigRun DriveOnce(double ci, const std::string& drive, double slip) {
   SingleWheelRig rig(p, Prepared(ci));
   RigRun r;
   while (!rig.done()) rig.Step();
-  EXPECT_FALSE(rig.sunk());
-  EXPECT_TRUE(rig.error().empty()) << rig.error();
+  r.sunk = rig.sunk();
+  r.error = rig.error();
   const SingleWheelRig::Window w = rig.Measured();
   r.dp_w = w.dp / p.Weight();
   r.dp_w_std = w.dp_std / p.Weight();
@@ -65,6 +67,9 @@ const RigRun& Drive(double ci, const std::string& drive, double slip) {
   const auto key = std::make_tuple(ci, drive, slip);
   auto it = runs.find(key);
   if (it == runs.end()) it = runs.emplace(key, DriveOnce(ci, drive, slip)).first;
+  // each test that takes a run checks that it ran through
+  EXPECT_FALSE(it->second.sunk) << "CI " << ci << " " << drive << " " << slip;
+  EXPECT_TRUE(it->second.error.empty()) << it->second.error;
   return it->second;
 }
 

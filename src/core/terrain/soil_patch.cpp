@@ -268,7 +268,7 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   // a wheel past the side walls is off the soil: the run cannot go on as a run on this soil
   const double y_max = 0.5 * width_ - 0.5 * bin_->tire().width;
   for (size_t i = 0; i < wheels.size(); ++i)
-    if (std::abs(wheels[i].y()) > y_max)
+    if (std::abs(wheels[i].y() - bin_->params().origin.y()) > y_max)
       throw SimulationError(detail::Concat("dem_soil patch (", bin_->params().file, "): wheel ",
                                            wheels.size() == kWheels ? kWheelNames[i] : std::to_string(i), " is at y = ",
                                            wheels[i].y(), " m, off the soil (the patch is ", width_, " m wide, levels.",

@@ -33,7 +33,8 @@ SpeedDriver::SpeedDriver(const DriverParams& p, const PowertrainParams& pt, doub
     : p_(p), pt_(pt), mass_(vehicle_mass), radius_(wheel_radius), reduction_(reduction) {}
 
 double SpeedDriver::Steering(double y, double heading, double v) const {
-  if (!p_.steer || p_.wheelbase <= 0.0) return 0.0;
+  // (off while the vehicle stands or rolls back: pursuit ahead steers the wrong way in reverse)
+  if (!p_.steer || p_.wheelbase <= 0.0 || v <= 0.0) return 0.0;
   // pure pursuit: the arc through the vehicle and the point on the line `lookahead` ahead
   const double l = std::max(p_.lookahead_min, p_.lookahead_time * std::abs(v));
   // the point (x + l, 0) of the line seen from the vehicle: its lateral coordinate in the vehicle's
