@@ -26,8 +26,7 @@ MobilitySample Sample(const VehicleCoSim& sim, double t, const Eigen::Vector3d& 
   }
   s.thrust = veh.AppliedDriveTorque() / veh.driveline_reduction() / r;
   s.y = at.y();
-  const Eigen::Vector3d ax = veh.system().body(veh.chassis()).R.col(0);
-  s.heading = std::atan2(ax.y(), ax.x());
+  s.heading = veh.Heading();
   return s;
 }
 
@@ -71,9 +70,8 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
           in.period = control_every * dt;
           in.forward_speed = v;
           in.drive_shaft_speed = w_ds;
-          const Eigen::Vector3d ax = veh.system().body(veh.chassis()).R.col(0);
           in.lateral_offset = veh.ChassisFramePosition().y() - p0.y();
-          in.heading = std::atan2(ax.y(), ax.x());
+          in.heading = veh.Heading();
           cmd = driver.Exchange(in);
           ++r.driver_updates;
           veh.SetDriveTorqueRequest(cmd.drive_torque);

@@ -27,9 +27,14 @@ Vector3d Vehicle::ChassisFramePosition() const {
   return c.x - c.R * chassis_com_offset_;
 }
 void Vehicle::SetSteering(double fraction) {
-  steering_ = std::clamp(fraction, -1.0, 1.0);
   // the rack moving to +y (the vehicle's left) turns the wheels to the right
-  if (rack_ >= 0) system_.line_constraints[rack_].target = -steering_ * spec_.steering.max_rack_travel;
+  if (rack_ >= 0)
+    system_.line_constraints[rack_].target = -std::clamp(fraction, -1.0, 1.0) * spec_.steering.max_rack_travel;
+}
+
+double Vehicle::Heading() const {
+  const Eigen::Vector3d ax = system_.body(chassis_).R.col(0);
+  return std::atan2(ax.y(), ax.x());
 }
 
 double Vehicle::ForwardSpeed() const {

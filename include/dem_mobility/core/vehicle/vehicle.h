@@ -47,6 +47,7 @@ class Vehicle {
   Eigen::Vector3d ChassisFramePosition() const;
 
   double ForwardSpeed() const;       ///< chassis COM velocity along the chassis x axis [m/s]
+  double Heading() const;            ///< yaw of the chassis x axis from the world x axis, + left [rad]
   double DriveShaftSpeed() const;    ///< relative to the chassis [rad/s]
   double WheelSpeed(int i) const;    ///< spin relative to the upright [rad/s]
   double WheelLoad(int i) const { return wrench_[i].normal_force; }  ///< last terrain normal force [N]
@@ -63,7 +64,6 @@ class Vehicle {
   void SetBrakeEffort(double effort) { brake_effort_ = effort; }
   /// Steering: the rack's position servo to `fraction` of full lock (max_rack_travel; + left).
   void SetSteering(double fraction);
-  double Steering() const { return steering_; }
   double AppliedDriveTorque() const;
   double BrakeEffort() const { return brake_effort_; }
 
@@ -81,7 +81,7 @@ class Vehicle {
   int drive_ = -1;                ///< index into system_.torques
   Eigen::Vector3d chassis_com_offset_ = Eigen::Vector3d::Zero();
   double ride_height_ = 0.0;
-  double drive_request_ = 0.0, brake_effort_ = 0.0, steering_ = 0.0;
+  double drive_request_ = 0.0, brake_effort_ = 0.0;
   int rack_ = -1;                 ///< index into system_.line_constraints (the rack's prismatic joint)
   std::array<WheelWrench, 4> wrench_{};
 };
