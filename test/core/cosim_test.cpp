@@ -245,7 +245,8 @@ TEST(SpeedMadeGood, NoGoOnlyAfterAWholeStallWhileTheCommandAsksForMore) {
 // A plateau is a flat and quiet window: a speed that rises and falls within the window fits a
 // flat line but is no plateau; a flat speed with DEM-like noise is one.
 TEST(SpeedMadeGood, SteadyIsFlatAndQuietNotARiseAndFall) {
-  const PlateauParams p;  // 5 s window, |slope| <= 0.05 m/s^2, rms about the line <= 10 % of the mean
+  const PlateauParams p;  // 5 s window, |slope| <= 0.05 m/s^2, rms about the line <= 10 % of the mean,
+                          // |slope| over the trailing 2.5 s <= 0.1 m/s^2
   auto history = [](const std::function<double(double)>& speed) {
     std::vector<MobilitySample> h;
     for (int k = 0; k <= 900; ++k) h.push_back(MobilitySample{0.01 * k, 0.0, speed(0.01 * k), 0.01 * k, 0.0, 0.0,
@@ -265,6 +266,19 @@ TEST(SpeedMadeGood, SteadyIsFlatAndQuietNotARiseAndFall) {
   // the same wobble about 2 m/s is 10.6 % of the mean: above the 10 % scatter, no plateau
   EXPECT_EQ(DetectSpeedMadeGood(history([](double t) { return 2.0 + 0.3 * std::sin(44.0 * t); }), p, 25.0).status,
             "not_steady");
+  // a hump: up at 0.4 m/s^2 to 11.9 m/s at 6.5 s and down at 0.4 m/s^2 to 10.9 m/s at 9 s: the
+  // whole window's line is flat and its scatter 2.5 % of the mean; the trailing half falls at
+  // 0.4 m/s^2, four times the end tolerance: no plateau
+  const auto hump = history([](double t) { return t < 4.0 ? 10.9 : 11.9 - 0.4 * std::abs(t - 6.5); });
+  const SpeedMadeGood hu = DetectSpeedMadeGood(hump, p, 25.0);
+  EXPECT_LT(std::abs(hu.window_slope), p.tolerance);
+  EXPECT_EQ(hu.status, "not_steady");
+  // a rise that has ended: up at 0.08 m/s^2 over the window's first half, flat over the second
+  // (the vehicle reached its speed 2.5 s ago; the whole window's slope 0.04 m/s^2): steady
+  const SpeedMadeGood settled = DetectSpeedMadeGood(
+      history([](double t) { return t < 6.5 ? 10.0 + 0.08 * (t - 4.0) * (t > 4.0) : 10.2; }), p, 25.0);
+  EXPECT_NEAR(settled.window_slope, 0.04, 0.002);
+  EXPECT_EQ(settled.status, "steady") << settled.window_slope;
 }
 
 TEST(VehicleCoSim, EndsWhenSteadyIfAskedWithTheSpeedOfTheFullRun) {

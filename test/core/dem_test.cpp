@@ -43,6 +43,42 @@ TEST(Dem, DampedHeadOnCollisionMatchesTheAnalyticRestitution) {
   EXPECT_NEAR(Collide(p, v0, 0.02) / v0, e, 0.01 * e);
 }
 
+TEST(Dem, AHeldParticleIsAFixedSupportUntilReleased) {
+  // a particle striking a held one rebounds as from an immovable body: the restitution of the
+  // spring-dashpot with the striker's own mass (not the pair's reduced mass)
+  const SoilParams p = Elastic(2.1e4);
+  const double m = p.Mass(), k = p.NormalStiffness(), c = p.NormalDamping(), D = p.diameter;
+  const double zeta = c / (2.0 * std::sqrt(k * m));
+  const double e = std::exp(-M_PI * zeta / std::sqrt(1.0 - zeta * zeta));
+  DemSystem s(p, DemSettings());
+  s.set_gravity(Vector3d::Zero());
+  const double v0 = 0.5;
+  const Vector3d x0(0.0, 0.0, 0.0);
+  s.AddParticle(x0, Vector3d(0.3, 0.1, 0.0));
+  s.AddParticle(Vector3d(D + 1e-4, 0, 0), Vector3d(-v0, 0, 0));
+  s.set_held(0, true);
+  EXPECT_TRUE(s.held(0));
+  EXPECT_EQ(s.velocity(0), Vector3d::Zero());  // its velocity is taken away
+  s.Finalize(0.02 * 2.0 * std::sqrt(0.5 * m / k));
+  bool touched = false;
+  for (int i = 0; i < 200000 && !(touched && s.position(1).x() > D + 2e-4); ++i) {
+    s.Step();
+    touched = touched || s.contacts() > 0;
+    ASSERT_EQ(s.position(0), x0);
+    ASSERT_EQ(s.velocity(0), Vector3d::Zero());
+  }
+  ASSERT_TRUE(touched);
+  EXPECT_NEAR(s.velocity(1).x() / v0, e, 0.01 * e);
+  // released, it is a particle again: struck once more, it takes momentum (the pair keeps it)
+  s.set_held(0, false);
+  EXPECT_FALSE(s.held(0));
+  s.mutable_velocity(1) = Vector3d(-v0, 0, 0);
+  s.mutable_position(1) = Vector3d(D + 1e-4, 0, 0);
+  for (int i = 0; i < 200000 && !(s.position(1).x() - s.position(0).x() > D + 2e-4); ++i) s.Step();
+  EXPECT_LT(s.velocity(0).x(), -0.5 * v0);  // it moved off
+  EXPECT_NEAR(s.Momentum().x(), -m * v0, 1e-9 * m * v0);
+}
+
 std::vector<Vector3d> Cluster(int n, unsigned seed, double spacing) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-0.04, 0.04);

@@ -81,6 +81,13 @@ void DemSystem::set_plastic_deformation(int id, double dp) {
   if (finalized_) ledger_.exchanged += ParticleEnergy(EnergyTerms(), ps_, lists_, i);
 }
 
+void DemSystem::set_held(int id, bool held) {
+  const int i = ps_.LiveSlot(id);
+  if (held && finalized_) ledger_.exchanged -= 0.5 * mass_ * ps_.v[i].squaredNorm();  // its kinetic energy taken out
+  if (held) ps_.v[i].setZero();
+  ps_.held[i] = held ? 1 : 0;
+}
+
 void DemSystem::set_threads(int threads) {
   DM_THROW_UNLESS(threads >= 1, "DEM threads ", threads, " must be >= 1");
   settings_.threads = threads;
@@ -164,7 +171,7 @@ void DemSystem::Step() {
   double max_disp2 = 0.0;
 #pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(max : max_disp2)
   for (int i = 0; i < n; ++i) {
-    if (!ps_.live(i)) continue;
+    if (!ps_.live(i) || ps_.held[i]) continue;
     v[i] += h * inv_m * f[i];
     x[i] += dt_ * v[i];
     max_disp2 = std::max(max_disp2, (x[i] - ps_.x_built[i]).squaredNorm());
@@ -184,7 +191,7 @@ void DemSystem::Step() {
 #pragma omp parallel for schedule(static) num_threads(settings_.threads)
   for (int i = 0; i < n; ++i) {
     if (!ps_.live(i)) continue;
-    v[i] += h * inv_m * f[i];
+    if (!ps_.held[i]) v[i] += h * inv_m * f[i];
     const double dp =
         UpdatePlasticDeformation(soil_, ps_.plastic[i], ps_.max_repulsion[i], ps_.max_tension[i], dt_);
     if (dp != ps_.plastic[i]) {

@@ -31,6 +31,7 @@ int ParticleStore::Add(const Eigen::Vector3d& x0, const Eigen::Vector3d& v0, con
     max_tension.push_back(0.0);
     overlap.push_back(0.0);
     state.push_back(SlotState::kFree);
+    held.push_back(0);
     id_of_slot.push_back(kNoId);
   }
   ids_.push_back(IdRecord{IdRecord::State::kLive, p});
@@ -43,12 +44,14 @@ int ParticleStore::Add(const Eigen::Vector3d& x0, const Eigen::Vector3d& v0, con
   adhesion_max[p] = adhesion0;
   max_repulsion[p] = max_tension[p] = overlap[p] = 0.0;
   state[p] = st;
+  held[p] = 0;
   return id;
 }
 
 int ParticleStore::Remove(int id) {
   const int i = ids_[id].slot;
   state[i] = SlotState::kFree;
+  held[i] = 0;
   f[i].setZero();
   max_repulsion[i] = max_tension[i] = overlap[i] = 0.0;
   ids_[id].state = IdRecord::State::kRemoved;
@@ -67,6 +70,7 @@ void ParticleStore::Permute(const std::vector<int>& order) {
   PermuteSlots(&max_tension, order, 1);
   PermuteSlots(&overlap, order, 1);
   PermuteSlots(&state, order, 1);
+  PermuteSlots(&held, order, 1);
   PermuteSlots(&id_of_slot, order, 1);
   free_slots_.clear();
   for (int s = 0; s < slots(); ++s) {
@@ -82,7 +86,7 @@ void ParticleStore::Permute(const std::vector<int>& order) {
 size_t ParticleStore::MemoryBytes() const {
   auto bytes = [](const auto& a) { return a.capacity() * sizeof(a[0]); };
   return bytes(x) + bytes(v) + bytes(f) + bytes(x_built) + bytes(plastic) + bytes(adhesion_max) +
-         bytes(max_repulsion) + bytes(max_tension) + bytes(overlap) + bytes(state) + bytes(id_of_slot) +
+         bytes(max_repulsion) + bytes(max_tension) + bytes(overlap) + bytes(state) + bytes(held) + bytes(id_of_slot) +
          bytes(ids_) + bytes(free_slots_);
 }
 

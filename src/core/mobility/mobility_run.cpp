@@ -39,6 +39,7 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
   p.plateau.window = res.DoubleIn("plateau_window", 0.5, 60.0, 5.0);
   p.plateau.tolerance = res.Positive("plateau_tolerance", 0.05);
   p.plateau.scatter = res.Positive("plateau_scatter", 0.1);
+  p.plateau.end_tolerance = res.Positive("plateau_end_tolerance", 0.1);
   p.plateau.stall_speed = res.Positive("stall_speed", 0.2);
   p.plateau.stall_time = res.Positive("stall_time", 5.0);
   p.end_when_steady = res.Bool("end_when_steady", false);
@@ -53,6 +54,25 @@ double StalledFor(const std::vector<MobilitySample>& h, double stall_speed) {
     if (it->speed >= stall_speed || it->speed_command <= stall_speed) return h.back().t - it->t;
   return h.back().t - h.front().t;
 }
+
+namespace {
+
+/// The least-squares slope of speed against time over the samples from t0 on (0 for fewer than two).
+double TrailingSlope(const std::vector<MobilitySample>& h, double t0) {
+  double n = 0, st = 0, sv = 0, stt = 0, stv = 0;
+  for (auto it = h.rbegin(); it != h.rend() && it->t >= t0; ++it) {
+    n += 1;
+    st += it->t;
+    sv += it->speed;
+    stt += it->t * it->t;
+    stv += it->t * it->speed;
+  }
+  if (n < 2) return 0.0;
+  const double var_t = stt / n - (st / n) * (st / n);
+  return var_t > 0 ? (stv / n - (st / n) * (sv / n)) / var_t : 0.0;
+}
+
+}  // namespace
 
 SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const PlateauParams& p, double v_max) {
   SpeedMadeGood s;
@@ -86,7 +106,8 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
   s.value = mean;
   if (t_end < p.window || mean < p.stall_speed) {  // (under the stall speed: a stall, if it lasts)
     s.status = "not_steady";
-  } else if (std::abs(s.window_slope) > p.tolerance || residual > p.scatter * std::abs(mean)) {
+  } else if (std::abs(s.window_slope) > p.tolerance || residual > p.scatter * std::abs(mean) ||
+             std::abs(TrailingSlope(h, t_end - 0.5 * p.window)) > p.end_tolerance) {
     s.status = "not_steady";
   } else if (!limited && mean >= 0.98 * v_max) {
     s.status = "command_limited";

@@ -193,6 +193,12 @@ void SoilPatch::NextLayer() {
   free_.clear();
   for (int i = layer_begin_[layer_]; i < layer_begin_[layer_ + 1]; ++i) free_.push_back(i);
   std::stable_sort(free_.begin(), free_.end(), [&](int a, int b) { return sites_[a].x.z() < sites_[b].x.z(); });
+  // the layer before the last one laid is let go: the last one now holds it in front, as the bed
+  // held its neighbours (a freshly laid face, free, would relax and settle into the next layer's
+  // sites while that layer is laid, bottom up, and block them: at 3 m/s 8 % of the soil was lost)
+  DemSystem& dem = bin_->dem();
+  for (int id = prev_layer_first_id_; id < layer_first_id_; ++id)
+    if (dem.alive(id)) dem.set_held(id, false);
   prev_layer_first_id_ = layer_first_id_;
   layer_first_id_ = bin_->dem().size();
   GatherZone();
@@ -223,6 +229,7 @@ void SoilPatch::Emit() {
     DemSystem& dem = bin_->dem();
     const int id = dem.AddParticle(x);
     dem.set_plastic_deformation(id, s.plastic);
+    dem.set_held(id, true);  // until the layer after next starts (NextLayer)
     zone_.push_back(x);
     ++stats_.reemitted;
     return;

@@ -88,6 +88,12 @@ class DemSystem {
   /// consolidation-dependent adhesion of the soil law): a particle re-emitted with the state of the
   /// consolidated soil it replaces.
   void set_plastic_deformation(int id, double dp);
+  /// Holds a live particle in place (true: its velocity is zeroed and it is not integrated until
+  /// released; its contacts act on its neighbours as a fixed wall's would), or releases it. The
+  /// moving soil patch holds the soil it has just laid down until the next layer is in front of it
+  /// (as the bin's front wall held the bed).
+  void set_held(int id, bool held);
+  bool held(int id) const { return ps_.held[ps_.LiveSlot(id)] != 0; }
   /// Calls f(id, position, velocity) for every live particle, in storage order (cheap: no copies).
   template <class F>
   void ForEachParticle(F&& f) const {

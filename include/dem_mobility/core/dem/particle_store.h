@@ -49,6 +49,8 @@ class ParticleStore {
   // the largest repulsion, tension and overlap of the slot's contacts at the last force evaluation
   std::vector<double> max_repulsion, max_tension, overlap;
   std::vector<SlotState> state;
+  /// 1: held in place (zero velocity, not integrated; its contacts still act on its neighbours)
+  std::vector<unsigned char> held;
   std::vector<int> id_of_slot;  ///< the ID whose (last) state the slot holds, or kNoId
 
   int slots() const { return static_cast<int>(x.size()); }

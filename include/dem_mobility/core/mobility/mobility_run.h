@@ -24,6 +24,9 @@ struct PlateauParams {
   double window = 5.0;        ///< [s] trailing window the steady state is judged on
   double tolerance = 0.05;    ///< [m/s^2] largest |dv/dt| in the window that counts as steady
   double scatter = 0.1;       ///< largest rms speed about the window's fitted line, over its mean speed
+  /// [m/s^2] largest |dv/dt| over the window's trailing half (a rise and then a fall fit a flat
+  /// line over the whole window: the speed must not be falling or rising at the end)
+  double end_tolerance = 0.1;
   double stall_speed = 0.2;   ///< [m/s] below this for stall_time (while the command is above it): no-go
   double stall_time = 5.0;    ///< [s]
 };
