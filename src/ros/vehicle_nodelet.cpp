@@ -304,6 +304,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     m.status = r.Status();
     m.window_slope = r.smg.window_slope;
     m.window_speed_std = r.smg.window_std;
+    m.window_end_slope = r.smg.end_slope;
     m.window_samples = static_cast<uint32_t>(r.steady.samples);
     m.slip.assign(r.steady.slip.begin(), r.steady.slip.end());
     m.sinkage.assign(r.steady.sinkage.begin(), r.steady.sinkage.end());

@@ -272,6 +272,7 @@ TEST(SpeedMadeGood, SteadyIsFlatAndQuietNotARiseAndFall) {
   const auto hump = history([](double t) { return t < 4.0 ? 10.9 : 11.9 - 0.4 * std::abs(t - 6.5); });
   const SpeedMadeGood hu = DetectSpeedMadeGood(hump, p, 25.0);
   EXPECT_LT(std::abs(hu.window_slope), p.tolerance);
+  EXPECT_NEAR(hu.end_slope, -0.4, 1e-9);
   EXPECT_EQ(hu.status, "not_steady");
   // a rise that has ended: up at 0.08 m/s^2 over the window's first half, flat over the second
   // (the vehicle reached its speed 2.5 s ago; the whole window's slope 0.04 m/s^2): steady

@@ -138,11 +138,13 @@ TEST(SoilPatch, KeepsItsParticleCountAndReEmitsSoilLikeTheInitialBed) {
   // the wheels ride 0.5 m above the soil, so the patch follows them and nothing else touches it:
   // at 8 m/s to where the patch starts to follow (a wheel centroid at the sphere's initial centre),
   // at 3 m/s for 4.8 m (the emitter lays that soil down slowly: its faces stand longest) and at
-  // 8 m/s again; the soil is checked 2-2.4 m (of the wheels' travel) after it was laid, so the
-  // checks up to a centroid at x_slow_checked see the slowly laid soil
-  const double x_follow = patch.sphere_centre().x(), x_slow_end = x_follow + 4.8, x_slow_checked = x_follow + 6.7;
-  const double x_end = 12.8;
-  PatchStats slow;
+  // 8 m/s again. The laid front runs about 3.0 m ahead of the front wheels and the check window
+  // is 0.6-1.4 m ahead of them, so the window holds soil laid 1.6-2.4 m of travel earlier: the
+  // checks up to x_slow_end + 1.6 see soil laid slowly only, those from x_slow_end + 2.4 (+ 0.1 m
+  // for the front's drift) soil laid fast only
+  const double x_follow = patch.sphere_centre().x(), x_slow_end = x_follow + 4.8;
+  const double x_slow_checked = x_slow_end + 1.6, x_fast_checked = x_slow_end + 2.5, x_end = 12.8;
+  PatchStats slow, mixed;
   double x = 0.0;
   std::vector<WheelWrench> w;
   for (long k = 0; x < x_end; ++k) {
@@ -152,6 +154,7 @@ TEST(SoilPatch, KeepsItsParticleCountAndReEmitsSoilLikeTheInitialBed) {
     t->Advance(h);
     ASSERT_EQ(t->bin().dem().num_alive(), n0);
     if (x < x_slow_checked) slow = patch.stats();
+    if (x < x_fast_checked) mixed = patch.stats();
     x += v * h;
   }
   const PatchStats& s = patch.stats();
@@ -160,10 +163,10 @@ TEST(SoilPatch, KeepsItsParticleCountAndReEmitsSoilLikeTheInitialBed) {
   EXPECT_GT(s.copies, 3);
   // re-emitted soil ahead of the front wheels, checked against the bed: laid slowly, and fast
   ASSERT_GE(slow.checks, 10);
-  ASSERT_GE(s.checks - slow.checks, 5);
-  const int fast_checks = s.checks - slow.checks;
-  const double fast_density = (s.density_ratio_mean * s.checks - slow.density_ratio_mean * slow.checks) / fast_checks;
-  const double fast_offset = (s.surface_offset_mean * s.checks - slow.surface_offset_mean * slow.checks) / fast_checks;
+  const int fast_checks = s.checks - mixed.checks;
+  ASSERT_GE(fast_checks, 5);
+  const double fast_density = (s.density_ratio_mean * s.checks - mixed.density_ratio_mean * mixed.checks) / fast_checks;
+  const double fast_offset = (s.surface_offset_mean * s.checks - mixed.surface_offset_mean * mixed.checks) / fast_checks;
   std::printf("re-emitted %ld (strays %ld), copies %d, skipped sites %ld; %d checks: density ratio %.4f (%.4f-%.4f), "
               "surface offset %.4f m (largest %.4f m) of %.3f m depth; laid at 3 m/s (%d checks): density ratio %.4f, "
               "surface offset %.4f m; at 8 m/s (%d checks): %.4f, %.4f m\n",

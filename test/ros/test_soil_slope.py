@@ -144,7 +144,8 @@ class SoilSlopeRuns(unittest.TestCase):
         m, r = self.msgs[NS + 'result'][0], self.res
         self.assertEqual((m.status, m.error, m.kind, m.fidelity, m.terrain_model),
                          (r['status'], r['error'], r['kind'], r['fidelity'], r['terrain_model']))
-        for key in ('speed_made_good', 'speed_made_good_mph', 'window_slope', 'window_speed_std', 'window_samples',
+        for key in ('speed_made_good', 'speed_made_good_mph', 'window_slope', 'window_speed_std', 'window_end_slope',
+                    'window_samples',
                     'traction_coefficient', 'motion_resistance_coefficient', 'drawbar_margin', 'time_step',
                     'coupling_interval', 'steps', 'exchanges', 'simulated_time', 'wall_time', 'real_time_factor'):
             self.assertEqual(getattr(m, key), r[key], key)

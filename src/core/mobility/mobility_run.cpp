@@ -102,12 +102,13 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
   s.window_slope = var_t > 0 ? (stv / n - (st / n) * mean) / var_t : 0.0;
   s.window_std = std::sqrt(std::max(0.0, svv / n - mean * mean));
   // the scatter about the fitted line: a rise and a fall within the window fit a flat line too
+  s.end_slope = TrailingSlope(h, t_end - 0.5 * p.window);
   const double residual = std::sqrt(std::max(0.0, svv / n - mean * mean - s.window_slope * s.window_slope * var_t));
   s.value = mean;
   if (t_end < p.window || mean < p.stall_speed) {  // (under the stall speed: a stall, if it lasts)
     s.status = "not_steady";
   } else if (std::abs(s.window_slope) > p.tolerance || residual > p.scatter * std::abs(mean) ||
-             std::abs(TrailingSlope(h, t_end - 0.5 * p.window)) > p.end_tolerance) {
+             std::abs(s.end_slope) > p.end_tolerance) {
     s.status = "not_steady";
   } else if (!limited && mean >= 0.98 * v_max) {
     s.status = "command_limited";
@@ -162,6 +163,7 @@ ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParam
   f.Set("verdict", r.smg.status);
   f.Set("window_slope", r.smg.window_slope);
   f.Set("window_speed_std", r.smg.window_std);
+  f.Set("window_end_slope", r.smg.end_slope);
   f.Set("ended_early", r.ended_early);
   const SteadyFigures& s = r.steady;
   f.Set("window_samples", s.samples);

@@ -91,7 +91,8 @@ class DemSystem {
   /// Holds a live particle in place (true: its velocity is zeroed and it is not integrated until
   /// released; its contacts act on its neighbours as a fixed wall's would), or releases it. The
   /// moving soil patch holds the soil it has just laid down until the next layer is in front of it
-  /// (as the bin's front wall held the bed).
+  /// (as the bin's front wall held the bed). mutable_velocity() and mutable_position() still reach a
+  /// held particle: a velocity given to it is not integrated, but enters its contacts' damping.
   void set_held(int id, bool held);
   bool held(int id) const { return ps_.held[ps_.LiveSlot(id)] != 0; }
   /// Calls f(id, position, velocity) for every live particle, in storage order (cheap: no copies).

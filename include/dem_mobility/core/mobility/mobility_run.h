@@ -69,6 +69,7 @@ struct SpeedMadeGood {
   std::string status;       ///< steady | command_limited | no_go | not_steady
   double window_slope = 0.0;///< dv/dt over the judging window [m/s^2]
   double window_std = 0.0;  ///< speed standard deviation in the window [m/s]
+  double end_slope = 0.0;   ///< dv/dt over the window's trailing half [m/s^2]
 };
 
 /// How long the vehicle has been stalled at the end of the history [s]: the time since the last

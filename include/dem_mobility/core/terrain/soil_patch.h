@@ -21,7 +21,9 @@
 // Template sites that would overlap soil already there (at the seams between copies, or a
 // particle that fell or was thrown there) are skipped; the copies follow each other at the shift
 // (about the slice's length) at which the fewest sites clash per length laid. A particle that strays into the emitter's zone (thrown ahead, or pushed by the plate)
-// is re-emitted like one that left the sphere.
+// is re-emitted like one that left the sphere. The particles laid are held in place
+// (DemSystem::set_held) until the layer after theirs is complete: a laid face left free would
+// relax into the next layer's sites before they are filled, and the soil would come out light.
 #pragma once
 
 #include <Eigen/Core>
