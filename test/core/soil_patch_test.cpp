@@ -191,15 +191,17 @@ TEST(SoilPatch, RepeatsBitForBitForOneAndTwoThreadsWithTiresInTheSoil) {
   std::unique_ptr<DemSoilTerrain> a = PreparedPatch(-3.0), b = PreparedPatch(-3.0);
   b->set_threads(2);
   // the wheels start 1 m past the sphere's centre (a jump of the patch: hundreds re-emitted at
-  // once) and roll into the soil, from touching its top to 4 cm into it
+  // once) and roll into the soil, from touching its surface (the mean top of its highest
+  // particles) to 4 cm into it
   const double x0 = a->patch()->sphere_centre().x() + 1.0, r = a->bin().tire().radius;
+  const double z0 = a->bin().surface_height() + r;
   std::vector<long> touched(kWheels, 0);
-  Drive(a.get(), x0, r, 5.0, 600, [&](long) {
+  Drive(a.get(), x0, z0, 5.0, 600, [&](long) {
     std::vector<WheelWrench> w;
     a->GetWrenches(&w);
     for (int i = 0; i < kWheels; ++i) touched[i] += w[i].contacts;
-  }, r - 0.04);
-  Drive(b.get(), x0, r, 5.0, 600, {}, r - 0.04);
+  }, z0 - 0.04);
+  Drive(b.get(), x0, z0, 5.0, 600, {}, z0 - 0.04);
   EXPECT_GT(a->patch()->stats().reemitted, 500);
   ASSERT_EQ(a->bin().dem().size(), b->bin().dem().size());
   const auto xa = a->bin().dem().positions(), xb = b->bin().dem().positions();

@@ -290,8 +290,23 @@ DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire,
   description_.time_step = p.level.time_step;
   description_.fidelity = p.level.name;
   while (!bin_->prepared()) bin_->PrepareStep();
-  // the prepared surface to z = 0: the vehicle starts there with its tires touching
-  bin_->ShiftZ(-bin_->surface_height());
+  // The vehicle starts with its tires touching the plane z = 0. That plane goes through the top of
+  // the highest particle of the bed's interior (a diameter and more from the walls), so that no
+  // tire starts inside a particle; the bed's surface (the mean top of its highest particles, from
+  // which sinkage is measured) is then start_gap_ below it, and the vehicle settles onto the soil.
+  // (Placed on that mean, a tire at coarse started 0.46 d deep in a particle that stood above it,
+  // and squeezed it out at 47 m/s.)
+  {
+    const double d = p.level.particle_diameter, margin = 1.5 * d;
+    const double x0 = p.origin.x() + margin, x1 = p.origin.x() + p.level.length - margin;
+    const double y_max = 0.5 * p.level.width - margin;
+    double top = -std::numeric_limits<double>::infinity();
+    bin_->dem().ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
+      if (x.x() > x0 && x.x() < x1 && std::abs(x.y() - p.origin.y()) < y_max) top = std::max(top, x.z() + 0.5 * d);
+    });
+    start_gap_ = std::isfinite(top) ? std::max(0.0, top - bin_->surface_height()) : 0.0;
+  }
+  bin_->ShiftZ(-bin_->surface_height() - start_gap_);
   if (p.patch.enabled) patch_ = std::make_unique<SoilPatch>(bin_.get(), p.patch, p.seed);
   // the display surface: the bin's consolidated top (with a patch, over the whole travel)
   const SoilBinLevel& l = p.level;
@@ -311,6 +326,7 @@ DemSoilTerrain::DemSoilTerrain(const DemSoilTerrain& o)
       patch_(o.patch_ ? std::make_unique<SoilPatch>(*o.patch_, bin_.get()) : nullptr),
       prepare_wall_(o.prepare_wall_),
       advance_wall_(o.advance_wall_),
+      start_gap_(o.start_gap_),
       description_(o.description_),
       surface_mesh_(o.surface_mesh_),
       states_(o.states_),
@@ -347,6 +363,7 @@ void DemSoilTerrain::Describe(ResultFile* r) const {
   r->Set("soil_time_step", p.level.time_step);
   r->Set("particles", bin_->dem().num_alive());
   r->Set("soil_depth", bin_->surface_height() - bin_->floor_z());
+  r->Set("soil_start_gap", start_gap_);
   r->Set("soil_prepare_wall_time", prepare_wall_);
   r->Set("soil_advance_wall_time", advance_wall_);
   r->Set("soil_steps", bin_->dem().step_count());

@@ -10,6 +10,10 @@ namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
+namespace {
+constexpr double kToolLowering = 0.5;  ///< [m/s] the leveling tools' descent to their working height
+}  // namespace
+
 SoilPatchParams SoilPatchParams::Read(const YamlReader& y) {
   SoilPatchParams p;
   p.enabled = true;
@@ -239,14 +243,20 @@ void SoilPatch::Emit() {
 void SoilPatch::PlaceTools(double velocity) {
   DemSystem& dem = bin_->dem();
   const double x = centre_.x() + tool_offset_;
-  const double z = surface0_ + p_.leveling_clearance * d_;
+  // the tools are lowered to their working height at kToolLowering (they start on the highest
+  // particle under them: set down at once they would land inside the particles that stand above
+  // the bed's mean surface and throw them out)
+  const double target = surface0_ + p_.leveling_clearance * d_;
+  const double lowering = tool_z_ > target ? std::min(kToolLowering, (tool_z_ - target) / dem.dt()) : 0.0;
+  tool_z_ -= lowering * dem.dt();
+  const double z = tool_z_;
   DemWall& c = dem.mutable_wall(bin_->leveling_cylinder());
   c.position = Vector3d(x, 0.0, z + p_.leveling_radius);
-  c.velocity = Vector3d(velocity, 0.0, 0.0);
+  c.velocity = Vector3d(velocity, 0.0, -lowering);
   c.wrench_point = c.position;
   DemWall& pl = dem.mutable_wall(bin_->leveling_plate());
   pl.position = Vector3d(x - p_.plate_length, 0.0, z);
-  pl.velocity = Vector3d(velocity, 0.0, 0.0);
+  pl.velocity = Vector3d(velocity, 0.0, -lowering);
   pl.wrench_point = pl.position;
 }
 
@@ -284,6 +294,13 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
     started_ = true;
     tool_offset_ = front + p_.leveling_ahead - centre0_.x();
     check_every_ = std::max(1L, std::lround(p_.check_period / dt));
+    // the tools start on the highest particle under them (plate and cylinder, a diameter around)
+    const double x_cyl = centre_.x() + tool_offset_;
+    const double xa = x_cyl - p_.plate_length - d_, xb = x_cyl + p_.leveling_radius + d_;
+    tool_z_ = surface0_ + p_.leveling_clearance * d_;
+    dem.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
+      if (x.x() > xa && x.x() < xb) tool_z_ = std::max(tool_z_, x.z() + 0.5 * d_);
+    });
     PlaceTools(0.0);
   }
   if (!stats_.following && centroid >= centre0_.x()) {

@@ -183,6 +183,7 @@ class DemSoilTerrain final : public TerrainModel {
   std::unique_ptr<DemSoilBin> bin_;
   std::unique_ptr<SoilPatch> patch_;
   double prepare_wall_ = 0.0, advance_wall_ = 0.0;
+  double start_gap_ = 0.0;  ///< [m] the start plane z = 0 above the bed's surface (the highest particle's top)
   TerrainDescription description_;
   TriMesh surface_mesh_;
   std::vector<WheelState> states_;

@@ -123,6 +123,7 @@ class SoilPatch {
   int prev_layer_first_id_ = 0, layer_first_id_ = 0;
   bool started_ = false;
   double tool_offset_ = 0.0;         ///< leveling cylinder x - sphere centre x
+  double tool_z_ = 0.0;              ///< the plate's height now (lowered to its working height)
   double front_offset_ = 0.0;        ///< front wheels' x - wheel centroid x (at the start)
   long steps_ = 0, check_every_ = 1;
   double ratio_sum_ = 0.0, offset_sum_ = 0.0;
