@@ -171,7 +171,7 @@ TEST(Dem, ExcessiveOverlapStopsTheRun) {
     s.Step();
     FAIL() << "a 35 % overlap went through";
   } catch (const SimulationError& e) {
-    EXPECT_NE(std::string(e.what()).find("overlaps a neighbour by 0.34"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("overlaps a neighbour or a wall by 0.34"), std::string::npos) << e.what();
   }
 }
 

@@ -53,7 +53,7 @@ void CheckParticleOverlaps(const ParticleStore& ps, double diameter, double max_
   for (int i = 0; i < ps.slots(); ++i)
     if (ps.live(i) && (ps.overlap[i] > limit || !ps.f[i].allFinite()))
       throw SimulationError(detail::Concat("DEM step ", step, " (t = ", time, " s): particle ", ps.id_of_slot[i],
-                                           !ps.f[i].allFinite() ? " has a non-finite force" : " overlaps a neighbour by ",
+                                           !ps.f[i].allFinite() ? " has a non-finite force" : " overlaps a neighbour or a wall by ",
                                            ps.overlap[i] / diameter, " of the diameter (limit ", max_overlap, ")"));
 }
 
