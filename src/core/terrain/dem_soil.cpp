@@ -294,8 +294,6 @@ DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire,
   // the highest particle of the bed's interior (a diameter and more from the walls), so that no
   // tire starts inside a particle; the bed's surface (the mean top of its highest particles, from
   // which sinkage is measured) is then start_gap_ below it, and the vehicle settles onto the soil.
-  // (Placed on that mean, a tire at coarse started 0.46 d deep in a particle that stood above it,
-  // and squeezed it out at 47 m/s.)
   {
     const double d = p.level.particle_diameter, margin = 1.5 * d;
     const double x0 = p.origin.x() + margin, x1 = p.origin.x() + p.level.length - margin;

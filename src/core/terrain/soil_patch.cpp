@@ -240,13 +240,15 @@ void SoilPatch::Emit() {
   }
 }
 
+double SoilPatch::ToolWorkingHeight() const { return surface0_ + p_.leveling_clearance * d_; }
+
 void SoilPatch::PlaceTools(double velocity) {
   DemSystem& dem = bin_->dem();
   const double x = centre_.x() + tool_offset_;
   // the tools are lowered to their working height at kToolLowering (they start on the highest
   // particle under them: set down at once they would land inside the particles that stand above
   // the bed's mean surface and throw them out)
-  const double target = surface0_ + p_.leveling_clearance * d_;
+  const double target = ToolWorkingHeight();
   const double lowering = tool_z_ > target ? std::min(kToolLowering, (tool_z_ - target) / dem.dt()) : 0.0;
   tool_z_ -= lowering * dem.dt();
   const double z = tool_z_;
@@ -297,7 +299,7 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
     // the tools start on the highest particle under them (plate and cylinder, a diameter around)
     const double x_cyl = centre_.x() + tool_offset_;
     const double xa = x_cyl - p_.plate_length - d_, xb = x_cyl + p_.leveling_radius + d_;
-    tool_z_ = surface0_ + p_.leveling_clearance * d_;
+    tool_z_ = ToolWorkingHeight();
     dem.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
       if (x.x() > xa && x.x() < xb) tool_z_ = std::max(tool_z_, x.z() + 0.5 * d_);
     });

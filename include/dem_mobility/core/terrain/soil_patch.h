@@ -102,6 +102,8 @@ class SoilPatch {
   void Emit();
   void Check(double front_wheels_x);
   void PlaceTools(double velocity);
+  /// The plate's height once lowered: the initial surface plus the leveling clearance.
+  double ToolWorkingHeight() const;
 
   DemSoilBin* bin_;
   SoilPatchParams p_;
