@@ -5,8 +5,11 @@ and case (grade, cone index), one run at a time by default, and writes into OUT:
 
   runs/<level>_g<grade>_ci<ci>.bag (+ .result.yaml, .log)   every run
   study.yaml     per case and level: speed-made-good, status, wall time (preparation included),
-                 simulated time, particles, and the error against the finest level that ran
-  study.md       the same as a Markdown table (docs/vehicle-on-soil.md takes it)
+                 simulated time, particles, and the error against the finest level that ran; per
+                 level its error estimate (the largest of those errors: levels.<level>.speed_error
+                 of config/terrains/soil_patch.yaml) and the default level by the rule: the
+                 cheapest level within 1 m/s of the finest in every case
+  study.md       the same as a Markdown table and list (docs/vehicle-on-soil.md takes it)
   study.png      speed-made-good against wall time, one line per case, the finest level marked
 
     python3 scripts/soil_fidelity_study.py --levels tiny,coarse --cases 12:100,0:50 --out results/soil_fidelity
@@ -108,6 +111,48 @@ def summarize(sweep, cases_gs):
     return rows
 
 
+def level_summary(rows, tolerance=1.0):
+    """Per level: its largest |error| against the finest level over the cases where a finer level
+    ran (its error estimate), and the default level by the issue's rule: the cheapest level whose
+    speed-made-good is within `tolerance` m/s of the finest in every case. Only a level that ran
+    every case is a candidate, and the finest level that did is the reference; the choice is
+    'provisional' while the reference is the only level that ran some case."""
+    cases = sorted({(r['grade'], r['cone_index']) for r in rows})
+    ran = {}
+    for r in rows:
+        ran.setdefault(r['level'], {})[(r['grade'], r['cone_index'])] = r
+    complete = [l for l in LEVEL_ORDER if l in ran and all(c in ran[l] for c in cases)]
+    levels = {}
+    for level in LEVEL_ORDER:
+        if level not in ran:
+            continue
+        compared = [x for x in ran[level].values() if x['reference'] != level]
+        levels[level] = {
+            'cases_run': len(ran[level]),
+            'cases_compared': len(compared),
+            'speed_error': max((x['error_vs_finest'] for x in compared), default=None),
+            'reference': sorted({x['reference'] for x in compared}),
+            'wall_time': sum(x['wall_time'] for x in ran[level].values()),
+        }
+    out = {'tolerance': tolerance, 'cases': [list(c) for c in cases], 'levels': levels, 'default_level': None,
+           'rule': 'the cheapest level (wall time over all cases) within %g m/s of the finest level in every case'
+           % tolerance}
+    if not complete:
+        out['why'] = 'no level ran every case'
+        return out
+    reference = complete[0]
+    within = [l for l in complete
+              if all(abs(ran[l][c]['speed_made_good'] - ran[reference][c]['speed_made_good']) <= tolerance
+                     for c in cases)]
+    chosen = min(within, key=lambda l: levels[l]['wall_time'])
+    out['default_level'] = chosen
+    out['reference_level'] = reference
+    out['provisional'] = len(complete) < 2
+    if out['provisional']:
+        out['why'] = 'only %s ran every case: nothing to compare it with' % reference
+    return out
+
+
 def write_table(rows, path):
     with open(path, 'w') as fh:
         fh.write('| grade [deg] | CI [psi] | level | d [m] | particles | speed-made-good [m/s] | status | '
@@ -118,6 +163,22 @@ def write_table(rows, path):
                 r['grade'], r['cone_index'], r['level'], r['particle_diameter'], r['particles'], r['speed_made_good'],
                 r['status'], 'reference' if r['level'] == r['reference'] else '%.3f' % r['error_vs_finest'],
                 r['wall_time'], r['prepare_wall_time'], r['simulated_time'], r['patch_density_ratio']))
+
+
+def summary_text(summary):
+    lines = []
+    for level, x in summary['levels'].items():
+        err = ('%.3f m/s over %d case(s) against %s' % (x['speed_error'], x['cases_compared'], ', '.join(x['reference']))
+               if x['speed_error'] is not None else 'none (no finer level ran its cases)')
+        lines.append('- %s: largest |error| vs finest %s; wall time over its %d case(s) %.0f s' % (
+            level, err, x['cases_run'], x['wall_time']))
+    if summary['default_level']:
+        lines.append('- default level by the rule (%s): **%s**%s' % (
+            summary['rule'], summary['default_level'],
+            ' (provisional: %s)' % summary['why'] if summary.get('provisional') else ''))
+    else:
+        lines.append('- no default level: %s' % summary['why'])
+    return '\n'.join(lines) + '\n'
 
 
 def plot(rows, path):
@@ -172,10 +233,14 @@ def main():
                                port=a.port, timeout=a.timeout, check=check, accept_status=STATUSES,
                                summary=os.path.join(a.out, 'sweep.yaml'))
     rows = summarize(sweep, a.cases)
+    summary = level_summary(rows)
     with open(os.path.join(a.out, 'study.yaml'), 'w') as fh:
-        yaml.safe_dump({'runner': a.runner, 'levels': levels, 'rows': rows}, fh, sort_keys=False)
+        yaml.safe_dump({'runner': a.runner, 'levels': levels, 'rows': rows, 'summary': summary}, fh,
+                       sort_keys=False)
     if rows:
         write_table(rows, os.path.join(a.out, 'study.md'))
+        with open(os.path.join(a.out, 'study.md'), 'a') as fh:
+            fh.write('\n' + summary_text(summary))
         plot(rows, os.path.join(a.out, 'study.png'))
         print(open(os.path.join(a.out, 'study.md')).read())
     return sweep.exit_status()

@@ -1,0 +1,64 @@
+"""Unit tests of scripts/soil_fidelity_study.py's summary (no runs): the levels' error estimates
+and the default level by the issue's rule (the cheapest within 1 m/s of the finest in every case).
+
+    python3 -m unittest discover -s test/python -v      (from the repository root)
+"""
+import os
+import sys
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, 'scripts'))
+import soil_fidelity_study as study  # noqa: E402
+
+
+def rows_of(runs):
+    """runs: {(grade, ci): {level: (speed, wall)}} -> the rows summarize() makes."""
+    rows = []
+    for (g, ci), by_level in runs.items():
+        finest = next(l for l in study.LEVEL_ORDER if l in by_level)
+        for level in study.LEVEL_ORDER:
+            if level in by_level:
+                v, wall = by_level[level]
+                rows.append(dict(grade=g, cone_index=ci, level=level, speed_made_good=v, wall_time=wall,
+                                 reference=finest, error_vs_finest=abs(v - by_level[finest][0])))
+    return rows
+
+
+class LevelSummary(unittest.TestCase):
+    def test_the_cheapest_level_within_a_metre_per_second_in_every_case_is_chosen(self):
+        s = study.level_summary(rows_of({(12, 100): {'coarse': (6.0, 7000), 'tiny': (6.9, 1700)},
+                                         (0, 50): {'coarse': (8.0, 9000), 'tiny': (7.2, 2400)}}))
+        self.assertEqual(s['default_level'], 'tiny')
+        self.assertEqual(s['reference_level'], 'coarse')
+        self.assertFalse(s['provisional'])
+        self.assertAlmostEqual(s['levels']['tiny']['speed_error'], 0.9)  # the larger of 0.9 and 0.8
+        self.assertIsNone(s['levels']['coarse']['speed_error'])  # nothing finer ran
+        self.assertEqual(s['levels']['tiny']['wall_time'], 4100)
+
+    def test_one_case_out_of_tolerance_keeps_the_finer_level(self):
+        s = study.level_summary(rows_of({(12, 100): {'coarse': (6.0, 7000), 'tiny': (6.5, 1700)},
+                                         (0, 50): {'coarse': (8.0, 9000), 'tiny': (9.2, 2400)}}))
+        self.assertEqual(s['default_level'], 'coarse')
+        self.assertAlmostEqual(s['levels']['tiny']['speed_error'], 1.2)
+
+    def test_a_level_that_did_not_run_every_case_is_neither_reference_nor_candidate(self):
+        # medium ran one case only: coarse is the reference of the rule; tiny's error in that case
+        # is still measured against medium (the finest run of that case)
+        s = study.level_summary(rows_of({(12, 100): {'medium': (5.0, 20000), 'coarse': (6.0, 7000), 'tiny': (6.5, 1700)},
+                                         (0, 50): {'coarse': (8.0, 9000), 'tiny': (8.5, 2400)}}))
+        self.assertEqual(s['reference_level'], 'coarse')
+        self.assertEqual(s['default_level'], 'tiny')
+        self.assertAlmostEqual(s['levels']['tiny']['speed_error'], 1.5)
+        self.assertEqual(s['levels']['tiny']['reference'], ['coarse', 'medium'])
+
+    def test_a_single_level_gives_only_a_provisional_choice(self):
+        s = study.level_summary(rows_of({(12, 100): {'tiny': (6.5, 1700)}}))
+        self.assertEqual(s['default_level'], 'tiny')
+        self.assertTrue(s['provisional'])
+        self.assertIn('no default level', study.summary_text(study.level_summary([])))
+        self.assertIn('provisional', study.summary_text(s))
+
+
+if __name__ == '__main__':
+    unittest.main()
