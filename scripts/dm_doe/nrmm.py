@@ -23,7 +23,8 @@ import os
 
 import yaml
 
-PSI = 6.894757e3          # Pa
+from dm_sweep import wheel_numerics
+
 LB = 0.45359237           # kg
 INCH = 0.0254             # m
 HP = 745.699872           # W
@@ -147,19 +148,15 @@ class Vehicle:
         return self.mass * G * math.cos(grade_rad) / self.tires
 
     def vti(self, ci_psi, grade_rad=0.0):
-        """The VTI numerics of one wheel: N_c, S_sp and the powered motion resistance MR/W."""
-        w_kn = self.wheel_load(grade_rad) / 1e3
-        ci_kpa = ci_psi * PSI / 1e3
-        n_cz = ci_kpa * self.b * self.d / (w_kn * (1.0 - self.deflection) ** 1.5)
-        n_c = n_cz / (1.0 + self.b / self.d) ** 0.75
-        s_sp = 21.0 / n_c ** 2.5 + 0.005
-        mr = 12.0 / n_c ** 2 + 0.007
-        return n_c, s_sp, mr
+        """The VTI numerics of one wheel (dm_sweep.wheel_numerics, the single-wheel rig's reference
+        band): N_c, S_sp and the powered motion resistance MR/W."""
+        x = wheel_numerics.vti(ci_psi, self.b, self.d, self.wheel_load(grade_rad), self.deflection)
+        return x['nc'], x['ssp'], x['mr_powered']
 
     def net_pull(self, ci_psi, slip, grade_rad=0.0):
-        """DP/W at a slip (net traction coefficient; negative below the self-propelled slip)."""
-        _, s_sp, _ = self.vti(ci_psi, grade_rad)
-        return 0.5 * (1.0 + self.b / self.d) ** 0.25 * math.log10(slip / s_sp)
+        """DP/W at a slip (net traction coefficient; negative below the self-propelled slip; uncapped)."""
+        n_c, s_sp, _ = self.vti(ci_psi, grade_rad)
+        return wheel_numerics.vti_dp_over_w(slip, n_c, self.b, self.d, s_sp, cap=False)
 
     # -- the WOT tractive force -----------------------------------------------------------------
     def wot_torque(self, w):
