@@ -13,6 +13,8 @@ DM_ROS_PACKAGES=(catkin ros-core-dev libroscpp-dev libnodeletlib-dev librosbag-d
   libtf2-eigen-dev libnodeletlib-tools ros-geometry-msgs ros-sensor-msgs ros-visualization-msgs ros-message-generation
   ros-nav-msgs ros-rosgraph-msgs ros-tf2-msgs libtopic-tools-dev pluginlib-dev
   python3-rosbag python3-roslaunch python3-rostest python3-catkin-pkg python3-std-msgs python3-geometry-msgs python3-nodelet python3-matplotlib python3-numpy python3-yaml python3-tqdm)
+# the maps of the design of experiments (GDAL's tools and python bindings)
+DM_MAP_PACKAGES=(gdal-bin python3-gdal)
 # only for the checks of the test command (package lint, rviz screenshot under Xvfb)
 DM_CHECK_PACKAGES=(catkin-lint rviz xvfb imagemagick)
 # only for the dem_step benchmark (the side-by-side LAMMPS run)
