@@ -22,6 +22,7 @@
 #include "dem_mobility/TerrainReport.h"
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
+#include "dem_mobility/core/cosim/vehicle_cosim.h"
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
@@ -75,8 +76,10 @@ class TerrainNodelet : public nodelet::Nodelet {
         NODELET_INFO("terrain '%s' from %s (level '%s'): preparing ...", d.model.c_str(), scene.terrain_file.c_str(),
                      d.fidelity.c_str());
       const auto t0 = std::chrono::steady_clock::now();
-      std::unique_ptr<TerrainModel> model = LoadTerrainModel(
-          scene.terrain_file, TerrainVehicle{VehicleSpec::Load(scene.vehicle_file).tire, kWheels}, scene.terrain_overrides);
+      std::unique_ptr<TerrainModel> model =
+          LoadTerrainModel(scene.terrain_file, TerrainVehicleOf(VehicleSpec::Load(scene.vehicle_file)),
+                           scene.terrain_overrides);
+      model->SetGravity(VehicleCoSim::GradeGravity(scene.grade_deg));  // the soil on the grade, as in-process
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       server = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
           nh, transport, exchange_name_, "exchange/wheel_states", "exchange/wheel_wrenches", timing);

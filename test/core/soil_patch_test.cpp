@@ -270,6 +270,58 @@ TEST(VehicleOnSoil, AtRestCarriesItsWeightAndStopsSinking) {
       << "sinkage " << s_early << " -> " << s0 << " -> " << s1 << " m";
 }
 
+TEST(VehicleOnSoil, TheSoilsOwnWeightIsOnTheGradeAndTheBoxCarriesIt) {
+  // paper section 4.3: the soil patch is set to the grade. A mobility run puts the soil under the
+  // grade's gravity (the vehicle's), and the box then carries the soil's weight: at rest the
+  // particles' push on the walls sums to their weight N m g, along the slope -N m g sin(theta)
+  const double grade = 20.0, a = grade * M_PI / 180.0;
+  MobilityRunParams p = SoilScene(grade, {"settle_time=0.01", "duration=0.01"});
+  MobilityRun run(p, PreparedPatch(100.0, kShortBox));
+  const auto& soil = dynamic_cast<const DemSoilTerrain&>(run.terrain());
+  const Vector3d g = soil.bin().dem().gravity();
+  EXPECT_NEAR(g.x(), -9.81 * std::sin(a), 1e-12);
+  EXPECT_NEAR(g.z(), -9.81 * std::cos(a), 1e-12);
+  ResultFile r(kScene, "soil_slope");
+  soil.Describe(&r);
+  EXPECT_NE(r.Text().find("soil_grade_deg: 20"), std::string::npos) << r.Text();
+  // the bed alone (the tires parked above it) turned onto the grade for 0.2 s: gravity and the
+  // walls are the only forces from outside (the pair forces cancel), so with the velocity-Verlet
+  // kicks the momentum changes by sum dt/2 (F_k + F_k+1), F = N m g - (the particles' push on the
+  // walls); and the box holds the bed: it does not slide off as it would without one
+  std::unique_ptr<DemSoilTerrain> t = PreparedPatch(100.0, kShortBox);
+  DemSystem& dem = t->mutable_bin().dem();
+  const double h = t->description().time_step, N = dem.num_alive(), m = dem.mass();
+  auto push = [&dem] {
+    Vector3d f = Vector3d::Zero();
+    for (int w = 0; w < dem.num_walls(); ++w) f += dem.wall(w).force;
+    return f;
+  };
+  Vector3d external = N * m * dem.gravity() - push();  // the forces of the last evaluation (flat)
+  t->SetGravity(g);
+  const Vector3d p0 = dem.Momentum();
+  Vector3d impulse = Vector3d::Zero(), x0 = Vector3d::Zero(), x1 = Vector3d::Zero();
+  for (int i = 0; i < dem.size(); ++i)
+    if (dem.alive(i)) x0 += dem.position(i) / N;
+  const int steps = static_cast<int>(0.5 / h);
+  for (int k = 0; k < steps; ++k) {
+    dem.Step();
+    const Vector3d next = N * m * g - push();
+    impulse += 0.5 * h * (external + next);
+    external = next;
+  }
+  for (int i = 0; i < dem.size(); ++i)
+    if (dem.alive(i)) x1 += dem.position(i) / N;
+  const Vector3d dp = dem.Momentum() - p0;
+  const double slide = 9.81 * std::sin(a) * steps * h;  // the speed of a frictionless slide [m/s]
+  std::printf("%.0f particles turned onto %.0f deg for %.2f s: momentum change (%.3f, %.3f, %.3f), impulse of gravity "
+              "and walls (%.3f, %.3f, %.3f) N s; mean velocity along the slope %.4f m/s (a free slide: %.2f), "
+              "mean shift (%.4f, %.4f) m\n",
+              N, grade, steps * h, dp.x(), dp.y(), dp.z(), impulse.x(), impulse.y(), impulse.z(), dp.x() / (N * m), slide,
+              (x1 - x0).x(), (x1 - x0).z());
+  EXPECT_LT((dp - impulse).norm(), 1e-6 * N * m * 9.81 * steps * h);
+  EXPECT_LT(std::abs(dem.Momentum().x()) / (N * m), 0.05 * slide);
+}
+
 TEST(VehicleOnSoil, StuckOnASteepGradeOfSoftSoilEndsTheRunWithZero) {
   // 30 deg at CI 30: the wheels dig in and spin; under 0.2 m/s for 5 s ends the run (no-go)
   MobilityRunParams p = SoilScene(30.0, {"settle_time=0.5"});

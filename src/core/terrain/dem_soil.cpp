@@ -350,6 +350,11 @@ TerrainDisplay DemSoilTerrain::Display() const {
   return d;
 }
 
+void DemSoilTerrain::SetGravity(const Vector3d& g) {
+  DM_THROW_UNLESS(g.allFinite() && g.norm() > 0.0, "dem_soil terrain: gravity ", g.transpose(), " is not a direction");
+  bin_->dem().set_gravity(g);
+}
+
 void DemSoilTerrain::Describe(ResultFile* r) const {
   const DemSoilParams& p = bin_->params();
   p.Describe(r);
@@ -359,6 +364,9 @@ void DemSoilTerrain::Describe(ResultFile* r) const {
     r->Set("speed_error_estimate", std::string("not measured for level '") + p.level.name + "'");
   if (!p.level.speed_error_note.empty()) r->Set("speed_error_note", p.level.speed_error_note);
   r->Set("soil_time_step", p.level.time_step);
+  // the grade the soil's own weight is on (its gravity against the bed's normal, -z)
+  const Vector3d g = bin_->dem().gravity();
+  r->Set("soil_grade_deg", std::atan2(-g.x(), -g.z()) * 180.0 / M_PI);
   r->Set("particles", bin_->dem().num_alive());
   r->Set("soil_depth", bin_->surface_height() - bin_->floor_z());
   r->Set("soil_start_gap", start_gap_);

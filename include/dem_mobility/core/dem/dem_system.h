@@ -57,6 +57,7 @@ class DemSystem {
   /// Gravity in any direction (a grade is a rotated gravity vector). Changing it during a run
   /// enters the energy ledger as exchanged energy.
   void set_gravity(const Eigen::Vector3d& g);
+  const Eigen::Vector3d& gravity() const { return gravity_; }
   /// Adds a wall (before Finalize); returns its index. A moving wall gets its pose and velocity
   /// set through mutable_wall() before each Step (prescribed motion, or a multibody body's state).
   int AddWall(DemWall wall);

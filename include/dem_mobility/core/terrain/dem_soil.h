@@ -171,6 +171,9 @@ class DemSoilTerrain final : public TerrainModel {
   const TriMesh& Surface() const override { return surface_mesh_; }
   TerrainDisplay Display() const override;
   void Describe(ResultFile* r) const override;
+  /// The grade's gravity on every particle (prepared under gravity along -z, the bed's normal: one
+  /// prepared bed serves every grade; it settles under the rotated gravity with the vehicle).
+  void SetGravity(const Eigen::Vector3d& g) override;
   const DemSoilBin& bin() const { return *bin_; }
   DemSoilBin& mutable_bin() { return *bin_; }
   /// The moving patch (nullptr without one).

@@ -50,6 +50,10 @@ class TerrainModel {
   virtual const TriMesh& Surface() const = 0;
   /// Its particles and tools, for display (a rigid terrain has none).
   virtual TerrainDisplay Display() const { return TerrainDisplay(); }
+  /// The scene's gravity (a grade is a rotated gravity vector, paper section 4.3: the terrain and
+  /// the soil patch are set to the grade). A terrain with mass of its own (the DEM soil) puts its
+  /// particles under it from the next step on; a rigid one has nothing to put under it.
+  virtual void SetGravity(const Eigen::Vector3d& /*g*/) {}
   /// Writes the terrain's own figures into a run's result (a soil's level, f, cone index and
   /// table, the moving patch's checks); a rigid terrain has none.
   virtual void Describe(ResultFile* /*r*/) const {}
