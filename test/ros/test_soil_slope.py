@@ -113,6 +113,9 @@ class SoilSlopeRuns(unittest.TestCase):
                                places=12)
         self.assertGreater(r['particles'], 5000)
         self.assertGreater(r['soil_prepare_wall_time'], 0.0)
+        # the soil's own weight on the scene's grade (the terrain nodelet turns it, as in-process)
+        self.assertNotEqual(r['grade_deg'], 0.0)
+        self.assertAlmostEqual(r['soil_grade_deg'], r['grade_deg'], places=9)
         for key in ('soil_time_step', 'soil_steps', 'patch_following', 'patch_reemitted', 'patch_density_ratio',
                     'patch_surface_offset', 'slip', 'sinkage', 'traction_coefficient',
                     'motion_resistance_coefficient', 'drawbar_margin'):
