@@ -1,5 +1,5 @@
 """The NRMM-style empirical model: speed-made-good of a wheeled vehicle against cone index and
-positive grade, a model of its own beside the physics one (docs/nrmm.md; the relations, their
+positive grade, a model of its own beside the physics one (docs/doe.md, "The NRMM-style model"; the relations, their
 sources and confidence: ../shared/reference/nrmm-baseline.md).
 
 - Go/no-go: the mobility index MI (Kennedy & Rush; FM 5-430-00-1) and the one-pass vehicle cone

@@ -1,0 +1,367 @@
+"""`doe`: the design of experiments over grade x cone index, from a raster to a map (docs/doe.md).
+
+    doe plan  --elevation DEM.tif [--ci CI.tif | --ci-seed N] --level tiny --out DIR
+    doe nrmm  --out DIR [--grades ... --cone-indices ...]
+    doe map   --table TABLE.yaml --elevation DEM.tif [--ci CI.tif | --ci-seed N] --out DIR [--compare OTHER.yaml]
+
+Every command has --help. Bad input (a raster without CRS, an empty grid, a CI outside the range
+a level can simulate) is refused naming the input, with exit status 2.
+"""
+import argparse
+import csv
+import datetime
+import math
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import yaml
+
+from . import maps, nrmm, plan, raster
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+CONFIG = os.path.join(ROOT, 'config')
+NRMM_VEHICLE = os.path.join(CONFIG, 'vehicles', 'hmmwv', 'nrmm.yaml')
+COSTS = os.path.join(CONFIG, 'doe', 'run_costs.yaml')
+
+
+class UsageError(ValueError):
+    pass
+
+
+def numbers(text):
+    try:
+        return [float(x) for x in text.split(',') if x.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError('expected numbers separated by commas, got %r' % text)
+
+
+def commit():
+    try:
+        return subprocess.check_output(['git', '-C', ROOT, 'rev-parse', '--short', 'HEAD'], text=True,
+                                       stderr=subprocess.DEVNULL).strip()
+    except (OSError, subprocess.CalledProcessError):
+        return 'unknown'
+
+
+def grid_of(a, slope=None, ci=None):
+    """The grid: the paper's (default), or the ranges found on the map (--grid map: G x C values
+    spanning the cells' slopes and CIs), or the given --grades and --cone-indices."""
+    if a.grades is not None or a.cone_indices is not None:
+        if a.grades is None or a.cone_indices is None:
+            raise UsageError('give both --grades and --cone-indices (or neither)')
+        return plan.Grid(a.grades, a.cone_indices)
+    if getattr(a, 'grid', 'paper') == 'map':
+        if slope is None:
+            raise UsageError('--grid map needs the map (--elevation)')
+        s_max = float(np.nanmax(slope))
+        c_lo, c_hi = float(np.nanmin(ci)), float(np.nanmax(ci))
+        g = [round(s_max * k / (a.grid_size[0] - 1), 3) for k in range(a.grid_size[0])]
+        c = [round(c_lo + (c_hi - c_lo) * k / (a.grid_size[1] - 1), 3) for k in range(a.grid_size[1])]
+        return plan.Grid(g, c)
+    return plan.Grid(plan.PAPER_GRADES, plan.PAPER_CONE_INDICES)
+
+
+def cells_of(a):
+    """The map's cells: (CellGrid, max slope [deg], min CI [psi], CI source)."""
+    elev = raster.read(a.elevation, 'elevation')
+    cells = raster.CellGrid(elev, a.cell_size, a.oversample)
+    slope = cells.max_slope()
+    if a.ci:
+        ci = cells.min_cone_index(raster.read(a.ci, 'cone index'))
+        source = a.ci
+        if np.nanmin(ci) <= 0:
+            raise UsageError('%s: cone index %.3g psi: a cone index must be positive' % (a.ci, np.nanmin(ci)))
+    else:
+        ci = raster.generate_ci(cells, seed=a.ci_seed)
+        source = 'generated (smooth random field, seed %d, 30-300 psi)' % a.ci_seed
+    ci = np.where(np.isnan(slope), np.nan, ci)
+    return cells, slope, ci, source
+
+
+# -- the NRMM table ---------------------------------------------------------------------------
+
+def write_table(path_stem, grid, rows, provenance):
+    """The case table as CSV and YAML (with provenance)."""
+    cols = ['grade_deg', 'cone_index', 'speed_made_good', 'speed_made_good_mph', 'status', 'source']
+    with open(path_stem + '.csv', 'w', newline='') as fh:
+        w = csv.writer(fh)
+        w.writerow(cols)
+        for r in rows:
+            w.writerow([r[c] for c in cols])
+    doc = dict(provenance, grades=grid.grades, cone_indices=grid.cone_indices,
+               speed=[[None] * len(grid.cone_indices) for _ in grid.grades], cases=rows)
+    for r in rows:
+        doc['speed'][grid.grades.index(r['grade_deg'])][grid.cone_indices.index(r['cone_index'])] = r['speed_made_good']
+    with open(path_stem + '.yaml', 'w') as fh:
+        yaml.safe_dump(doc, fh, sort_keys=False)
+    return path_stem + '.yaml'
+
+
+def read_table(path):
+    try:
+        with open(path) as fh:
+            doc = yaml.safe_load(fh)
+    except OSError as e:
+        raise UsageError('%s: cannot read the table (%s)' % (path, e.strerror))
+    for k in ('grades', 'cone_indices', 'speed'):
+        if not isinstance(doc, dict) or k not in doc:
+            raise UsageError('%s: not a case table (no %s)' % (path, k))
+    s = np.array([[np.nan if v is None else v for v in row] for row in doc['speed']], dtype=float)
+    if np.isnan(s).any():
+        raise UsageError('%s: the table has cases without a speed (the DOE is not finished)' % path)
+    plan.Grid(doc['grades'], doc['cone_indices'])
+    return dict(doc, speed=s)
+
+
+def speed_plots(out_dir, name, grid, speed, title):
+    """Figs. 23/24: speed-made-good against CI per grade and against grade per CI."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    s = np.asarray(speed) / maps.MPH
+    paths = []
+    for what in ('ci', 'grade'):
+        fig, ax = plt.subplots(figsize=(7, 4.5))
+        if what == 'ci':
+            for i, g in enumerate(grid.grades):
+                ax.plot(grid.cone_indices, s[i], 'o-', ms=3, label='%g deg' % g)
+            ax.set_xlabel('cone index [psi]')
+        else:
+            for j, c in enumerate(grid.cone_indices):
+                ax.plot(grid.grades, s[:, j], 'o-', ms=3, label='CI %g' % c)
+            ax.set_xlabel('grade [deg]')
+        ax.set_ylabel('speed-made-good [mph]')
+        ax.set_title(title, fontsize=10)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, ncol=2)
+        fig.tight_layout()
+        p = os.path.join(out_dir, '%s_speed_vs_%s.png' % (name, what))
+        fig.savefig(p, dpi=110)
+        plt.close(fig)
+        paths.append(p)
+    return paths
+
+
+def cmd_nrmm(a):
+    v = nrmm.Vehicle.load(a.vehicle)
+    grid = grid_of(a)
+    os.makedirs(a.out, exist_ok=True)
+    rows = []
+    for g in grid.grades:
+        for c in grid.cone_indices:
+            r = v.speed(g, c)
+            rows.append({'grade_deg': g, 'cone_index': c, 'speed_made_good': round(r['speed'], 6),
+                         'speed_made_good_mph': round(r['speed'] / maps.MPH, 4), 'status': r['status'],
+                         'source': 'nrmm (%s)' % r['limit']})
+    prov = {'model': 'nrmm', 'vehicle': os.path.abspath(a.vehicle), 'commit': commit(),
+            'made': datetime.datetime.utcnow().strftime('%Y-%m-%dT%H:%MZ'),
+            'mobility_index': round(v.mobility_index(), 3), 'vci1_psi': round(v.vci1(), 3),
+            'vci50_psi': round(v.vci50(), 3),
+            'relations': 'MI/VCI1 (Priddy & Willoughby 2006), VTI fine-grained traction (Dettwiller et al. 2018), '
+                         'WOT-limited speed on the grade (docs/doe.md)'}
+    path = write_table(os.path.join(a.out, 'nrmm_table'), grid, rows, prov)
+    speed = [[r['speed_made_good'] for r in rows[i * len(grid.cone_indices):(i + 1) * len(grid.cone_indices)]]
+             for i in range(len(grid.grades))]
+    speed_plots(a.out, 'nrmm', grid, speed, 'NRMM-style speed-made-good (MI %.1f, VCI1 %.1f psi)'
+                % (v.mobility_index(), v.vci1()))
+    print('nrmm: MI %.1f, VCI1 %.1f psi, VCI50 %.1f psi; %d x %d table: %s' % (
+        v.mobility_index(), v.vci1(), v.vci50(), len(grid.grades), len(grid.cone_indices), path))
+    return 0
+
+
+# -- maps -------------------------------------------------------------------------------------
+
+def cmd_map(a):
+    table = read_table(a.table)
+    cells, slope, ci, source = cells_of(a)
+    os.makedirs(a.out, exist_ok=True)
+    t0 = time.time()
+    speed = maps.speed_map(table, slope, ci, clamp_ci=a.clamp_ci)
+    t_map = time.time() - t0
+    top = float(np.nanmax(table['speed'])) if a.top_speed is None else a.top_speed
+    label = table.get('model', 'physics')
+    name = a.name or ('%s_smg' % label)
+    title = '%s speed-made-good [mph], %d x %d cells of %g m; CI: %s' % (
+        label, cells.shape[1], cells.shape[0], cells.cell_size, os.path.basename(source) if a.ci else 'generated')
+    out = maps.write_all(a.out, name, speed, cells, title, top)
+    raster.write_geotiff(os.path.join(a.out, 'cells_max_slope_deg.tif'), slope, cells.gt, cells.wkt, 'max slope [deg]')
+    raster.write_geotiff(os.path.join(a.out, 'cells_min_ci_psi.tif'), ci, cells.gt, cells.wkt, 'min CI [psi]')
+    beyond = int(np.sum(np.isnan(speed) & ~np.isnan(slope)))
+    report = {'table': os.path.abspath(a.table), 'elevation': os.path.abspath(a.elevation), 'cone_index': source,
+              'cells': list(cells.shape), 'cell_size': cells.cell_size, 'oversample': cells.oversample,
+              'reprojected_to_utm': cells.reprojected, 'interpolation_wall_time': round(t_map, 4),
+              'cells_beyond_the_table': beyond, 'outputs': out}
+    if a.compare:
+        other = read_table(a.compare)
+        s2 = maps.speed_map(other, slope, ci, clamp_ci=a.clamp_ci)
+        diff = speed - s2
+        dname = '%s_minus_%s' % (label, other.get('model', 'other'))
+        raster.write_geotiff(os.path.join(a.out, dname + '.tif'), diff, cells.gt, cells.wkt, dname + ' [m/s]')
+        maps.write_difference_png(os.path.join(a.out, dname + '.png'), diff, cells.cell_size,
+                                  '%s minus %s speed-made-good [mph]' % (label, other.get('model', 'other')))
+        report['difference'] = {'geotiff': os.path.join(a.out, dname + '.tif'), 'png': os.path.join(a.out, dname + '.png'),
+                                'mean_mph': round(float(np.nanmean(diff)) / maps.MPH, 3)}
+    with open(os.path.join(a.out, 'map.yaml'), 'w') as fh:
+        yaml.safe_dump(report, fh, sort_keys=False)
+    print('map: %d x %d cells interpolated in %.3f s (%d beyond the table: no value); %s' % (
+        cells.shape[1], cells.shape[0], t_map, beyond, ', '.join(out.values())))
+    return 0
+
+
+# -- plan -------------------------------------------------------------------------------------
+
+def level_ci_range(level, terrain=os.path.join(CONFIG, 'terrains', 'soil_patch.yaml')):
+    """(lowest, highest CI [psi], table file) a level can simulate: its calibration table's range
+    (the table made at the level's particle size and the terrain's inter-particle mu)."""
+    with open(terrain) as fh:
+        t = yaml.safe_load(fh)
+    if level not in t.get('levels', {}):
+        raise UsageError('--level %s: %s has no such level (have %s)' % (level, terrain, ', '.join(t['levels'])))
+    d, mu = float(t['levels'][level]['particle_diameter']), float(t['friction'])
+    folder = os.path.normpath(os.path.join(os.path.dirname(terrain), t['calibration']))
+    for name in sorted(os.listdir(folder)):
+        path = os.path.join(folder, name)
+        if not name.endswith('.yaml') or not os.path.isfile(path):
+            continue
+        with open(path) as fh:
+            c = yaml.safe_load(fh)
+        if isinstance(c, dict) and abs(float(c.get('particle_diameter', -1)) - d) < 1e-9 and \
+                abs(float(c.get('friction', -1)) - mu) < 1e-9 and c.get('table'):
+            cis = [row[0] for row in c['table']]
+            return min(cis), max(cis), path
+    raise UsageError('--level %s: no calibration table for %g m particles and mu %g in %s: a cone index cannot '
+                     'be simulated at this level' % (level, d, mu, folder))
+
+
+def check_cone_indices(grid, level):
+    """Every CI of the grid must be the road's (>= 300 psi) or inside the level's table."""
+    lo, hi, table = level_ci_range(level)
+    bad = [c for c in grid.cone_indices if c < plan.ROAD_CONE_INDEX and not (lo <= c <= hi)]
+    if bad:
+        raise UsageError('cone index %s psi: outside the %s level\'s calibration range %g-%g psi (%s); '
+                         'CI %g and above is the rigid road' % (', '.join('%g' % c for c in bad), level, lo, hi,
+                                                                table, plan.ROAD_CONE_INDEX))
+    return lo, hi, table
+
+
+def run_cost(costs, level, status, ci, road_ci=plan.ROAD_CONE_INDEX):
+    """Estimated wall seconds of one case."""
+    sim = costs['settle'] + (costs['no_go_duration'] if status == plan.NO_GO else costs['duration'])
+    if ci >= road_ci:
+        return sim * costs['road']['wall_per_sim_s']
+    c = costs['levels'][level]
+    return c['prepare'] + sim * c['wall_per_sim_s']
+
+
+def cmd_plan(a):
+    with open(COSTS) as fh:
+        costs = yaml.safe_load(fh)
+    if a.level not in costs['levels']:
+        raise UsageError('--level %s: no measured run cost for it in %s (have %s)' % (
+            a.level, COSTS, ', '.join(costs['levels'])))
+    slope = ci = None
+    if a.elevation:
+        _, slope, ci, _ = cells_of(a)
+    grid = grid_of(a, slope, ci)
+    if a.grades is None and a.cone_indices is None and a.grid == 'paper':
+        # the paper's CIs this level can simulate (and the road): a given CI outside is refused
+        lo, hi, table = level_ci_range(a.level)
+        keep = [c for c in grid.cone_indices if lo <= c <= hi or c >= plan.ROAD_CONE_INDEX]
+        dropped = [c for c in grid.cone_indices if c not in keep]
+        if dropped:
+            print('plan: the paper\'s CI %s psi lie outside the %s level\'s table (%g-%g psi): left out'
+                  % (', '.join('%g' % c for c in dropped), a.level, lo, hi))
+        grid = plan.Grid(grid.grades, keep)
+    lo, hi, table = check_cone_indices(grid, a.level)
+    v = nrmm.Vehicle.load(NRMM_VEHICLE)
+
+    def prior(cell):  # the NRMM model stands in for the outcomes the runs will have
+        r = v.speed(grid.grades[cell[0]], grid.cone_indices[cell[1]])
+        return r['status'], r['speed']
+    sim, imp = plan.replay(grid, prior)
+    full = sum(run_cost(costs, a.level, prior(c)[0], grid.cone_indices[c[1]]) for c in grid.cells())
+    pruned = sum(run_cost(costs, a.level, s, grid.cone_indices[c[1]]) for c, s, _ in sim)
+    upper = sum(run_cost(costs, a.level, 'steady', grid.cone_indices[c[1]]) for c in grid.cells())
+    print('plan: %d grades (%s) x %d cone indices (%s), level %s' % (
+        len(grid.grades), ', '.join('%g' % g for g in grid.grades), len(grid.cone_indices),
+        ', '.join('%g' % c for c in grid.cone_indices), a.level))
+    print('  the %s level simulates CI %g-%g psi (%s); CI %g is the rigid road' % (
+        a.level, lo, hi, os.path.relpath(table, ROOT), plan.ROAD_CONE_INDEX))
+    print('  run order: %s ...' % ', '.join('(%g deg, CI %g)' % (grid.grades[i], grid.cone_indices[j])
+                                            for i, j in grid.order()[:6]))
+    print('  estimated cost on %s, the NRMM model standing in for the outcomes (%s):' % (costs['machine'], COSTS))
+    print('    every case run:        %7.1f h (%d runs; at most %.1f h if none ended early)' % (
+        full / 3600, len(grid.cells()), upper / 3600))
+    print('    with pruning:          %7.1f h (%d runs, %d implied by their neighbours)' % (
+        pruned / 3600, len(sim), len(imp)))
+    print('  (the pruning the runs allow depends on their outcomes: the figures are an estimate)')
+    return 0
+
+
+# -- the command line -------------------------------------------------------------------------
+
+def parser():
+    ap = argparse.ArgumentParser(prog='doe', description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest='command', metavar='COMMAND')
+    sub.required = True
+
+    def grid_args(p):
+        p.add_argument('--grades', type=numbers, help='grades [deg], rising (default: the paper\'s 0, 3, ..., 39)')
+        p.add_argument('--cone-indices', type=numbers,
+                       help='cone indices [psi], rising (default: the paper\'s 12 of table 3, 30-300)')
+
+    def map_args(p, required=True):
+        p.add_argument('--elevation', required=required, help='elevation raster (GeoTIFF or anything GDAL reads; with a CRS)')
+        p.add_argument('--ci', help='cone index raster [psi] (any grid and CRS); default: a generated one')
+        p.add_argument('--ci-seed', type=int, default=1, help='seed of the generated CI field (default 1)')
+        p.add_argument('--cell-size', type=float, default=20.0, help='map cell size [m] (default 20)')
+        p.add_argument('--oversample', type=int, default=2, help='slope posts per cell side (default 2)')
+
+    p = sub.add_parser('plan', help='the grid, its run order and the estimated cost with and without pruning',
+                       description='Prints the design: the grid (the paper\'s, the map\'s ranges or given), the '
+                       'order the cases run in, and the estimated cost with and without pruning (a dry run: '
+                       'nothing is simulated).')
+    grid_args(p)
+    map_args(p, required=False)
+    p.add_argument('--grid', choices=('paper', 'map'), default='paper',
+                   help='paper: 14 x 12 (default); map: --grid-size values over the ranges found on the map')
+    p.add_argument('--grid-size', type=lambda t: [int(x) for x in t.split('x')], default=[14, 12],
+                   help='G x C for --grid map (default 14x12)')
+    p.add_argument('--level', default='tiny', help='soil fidelity level of the runs (default tiny)')
+    p.set_defaults(func=cmd_plan)
+
+    p = sub.add_parser('nrmm', help='the NRMM-style speed table on the grid, with its plots',
+                       description='Writes the NRMM-style model\'s speed-made-good table (CSV, YAML) on the grid '
+                       'and its plots against CI per grade and against grade per CI (docs/doe.md).')
+    grid_args(p)
+    p.add_argument('--vehicle', default=NRMM_VEHICLE, help='the vehicle\'s NRMM inputs (default %(default)s)')
+    p.add_argument('--out', required=True, help='output folder')
+    p.set_defaults(func=cmd_nrmm)
+
+    p = sub.add_parser('map', help='a speed-made-good map from a finished table',
+                       description='Interpolates a finished case table at every cell\'s (maximum slope, minimum '
+                       'CI) and writes the map as GeoTIFF, PNG and ROS map (and, with --compare, the difference '
+                       'map against another table).')
+    map_args(p)
+    p.add_argument('--table', required=True, help='a case table (YAML: doe nrmm, or a finished DOE)')
+    p.add_argument('--compare', help='another table: writes the difference map (table minus it)')
+    p.add_argument('--clamp-ci', action='store_true', help='take CIs beyond the table as its last column')
+    p.add_argument('--top-speed', type=float, help='the ROS map\'s free speed [m/s] (default: the table\'s highest)')
+    p.add_argument('--name', help='file name stem of the map')
+    p.add_argument('--out', required=True, help='output folder')
+    p.set_defaults(func=cmd_map)
+    return ap
+
+
+def main(argv=None):
+    ap = parser()
+    a = ap.parse_args(argv)
+    try:
+        return a.func(a)
+    except (UsageError, plan.PlanError, nrmm.NrmmError, raster.RasterError) as e:
+        print('doe %s: %s' % (a.command, e), file=sys.stderr)
+        return 2
