@@ -11,6 +11,7 @@ and case (grade, cone index), one run at a time by default, and writes into OUT:
                  cheapest level within 1 m/s of the finest in every case
   study.md       the same as a Markdown table and list (docs/vehicle-on-soil.md takes it)
   study.png      speed-made-good against wall time, one line per case, the finest level marked
+  histories.png  speed, command and lateral offset against time of every run (--runner core)
 
     python3 scripts/soil_fidelity_study.py --levels tiny,coarse --cases 12:100,0:50 --out results/soil_fidelity
 
@@ -181,6 +182,44 @@ def summary_text(summary):
     return '\n'.join(lines) + '\n'
 
 
+def plot_histories(runs_dir, names, path):
+    """Speed (and command) and lateral offset against time of the runs that wrote a history
+    (--runner core's <run>.history.csv): what each run did, one colour per run."""
+    import csv
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    fig, (ax, ay) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, gridspec_kw={'height_ratios': [2, 1]})
+    drawn = 0
+    for name in names:
+        f = os.path.join(runs_dir, name + '.history.csv')
+        if not os.path.exists(f):
+            continue
+        with open(f) as fh:
+            rows = list(csv.DictReader(fh))
+        if not rows:
+            continue
+        t = [float(r['t']) for r in rows]
+        line, = ax.plot(t, [float(r['speed']) for r in rows], lw=1.2, label=name)
+        ax.plot(t, [float(r['speed_command']) for r in rows], lw=0.8, ls='--', color=line.get_color())
+        ay.plot(t, [float(r['y']) for r in rows], lw=1.0, color=line.get_color())
+        drawn += 1
+    if not drawn:
+        plt.close(fig)
+        return None
+    ax.set_ylabel('speed [m/s] (dashed: command)')
+    ax.set_title('The study runs: speed and lateral offset')
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    ay.set_xlabel('time since the brakes were let go [s]')
+    ay.set_ylabel('lateral offset y [m]')
+    ay.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def plot(rows, path):
     import matplotlib
     matplotlib.use('Agg')
@@ -242,6 +281,7 @@ def main():
         with open(os.path.join(a.out, 'study.md'), 'a') as fh:
             fh.write('\n' + summary_text(summary))
         plot(rows, os.path.join(a.out, 'study.png'))
+        plot_histories(os.path.join(a.out, 'runs'), [c.name for c in cases], os.path.join(a.out, 'histories.png'))
         print(open(os.path.join(a.out, 'study.md')).read())
     return sweep.exit_status()
 
