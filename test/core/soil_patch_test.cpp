@@ -185,6 +185,24 @@ TEST(SoilPatch, KeepsItsParticleCountAndReEmitsSoilLikeTheInitialBed) {
   EXPECT_LT(s.surface_offset_max, 0.10 * depth);
   // the sphere follows the wheels' centroid (at the end of the last step: where it is now)
   EXPECT_NEAR(patch.sphere_centre().x(), x, 1e-9);
+  // the check log holds every check; those with 90 % re-emitted soil make the mean, and it is
+  // written as CSV, a line per check
+  double sum = 0.0;
+  int counted = 0;
+  for (const PatchCheck& c : s.log)
+    if (c.reemitted_fraction >= 0.9) {
+      sum += c.density_ratio;
+      ++counted;
+    }
+  EXPECT_EQ(counted, s.checks);
+  EXPECT_NEAR(sum / counted, s.density_ratio_mean, 1e-12);
+  const std::string csv = ::testing::TempDir() + "patch_checks.csv";
+  WritePatchChecks(s, csv);
+  std::ifstream in(csv);
+  std::string line;
+  long lines = 0;
+  while (std::getline(in, line)) ++lines;
+  EXPECT_EQ(lines, static_cast<long>(s.log.size()) + 1);
 }
 
 TEST(SoilPatch, RepeatsBitForBitForOneAndTwoThreadsWithTiresInTheSoil) {

@@ -13,6 +13,8 @@
 #include "dem_mobility/core/scenes/dem_pour.h"
 #include "dem_mobility/core/scenes/single_wheel.h"
 #include "dem_mobility/core/scenes/uniaxial_compression.h"
+#include "dem_mobility/core/terrain/dem_soil.h"
+#include "dem_mobility/core/terrain/soil_patch.h"
 
 namespace dem_mobility::core {
 namespace {
@@ -64,7 +66,17 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
   } progress(p.duration, o.quiet, o.stop);
   MobilityRunResult r = run.Run(&progress);
   try {
-    if (!o.history_file.empty()) WriteMobilityHistory(r, o.history_file);
+    if (!o.history_file.empty()) {
+      WriteMobilityHistory(r, o.history_file);
+      // the moving patch's checks of the soil ahead beside it (<history>.patch_checks.csv)
+      const auto* soil = dynamic_cast<const DemSoilTerrain*>(&run.terrain());
+      if (soil && soil->patch()) {
+        const std::string& h = o.history_file;
+        const size_t dot = h.rfind(".csv");
+        WritePatchChecks(soil->patch()->stats(),
+                         (dot != std::string::npos && dot + 4 == h.size() ? h.substr(0, dot) : h) + ".patch_checks.csv");
+      }
+    }
   } catch (const ConfigError& e) {  // the run is kept: its result says what failed
     if (r.error.empty()) r.error = e.what();
   }

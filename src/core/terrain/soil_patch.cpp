@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iomanip>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
@@ -264,8 +266,10 @@ void SoilPatch::PlaceTools(double velocity) {
 
 void SoilPatch::Check(double front_wheels_x) {
   const PatchSoilMeasure m = Measure(front_wheels_x + p_.check_from, front_wheels_x + p_.check_to);
-  if (m.particles == 0 || m.reemitted_fraction < 0.9) return;
+  if (m.particles == 0) return;
   const double ratio = m.density / stats_.initial.density, offset = m.surface - stats_.initial.surface;
+  stats_.log.push_back({bin_->dem().time(), front_wheels_x, ratio, offset, m.reemitted_fraction, m.particles});
+  if (m.reemitted_fraction < 0.9) return;
   ++stats_.checks;
   ratio_sum_ += ratio;
   offset_sum_ += offset;
@@ -352,6 +356,15 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   for (size_t k = 0; k < out.size(); ++k) Emit();
   ++steps_;
   if (steps_ % check_every_ == 0) Check(front);
+}
+
+void WritePatchChecks(const PatchStats& s, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw ConfigError(path + ": cannot write the patch's checks");
+  out << "t,front_x,density_ratio,surface_offset,reemitted_fraction,particles\n" << std::setprecision(8);
+  for (const PatchCheck& c : s.log)
+    out << c.t << "," << c.front_x << "," << c.density_ratio << "," << c.surface_offset << "," << c.reemitted_fraction
+        << "," << c.particles << "\n";
 }
 
 }  // namespace dem_mobility::core

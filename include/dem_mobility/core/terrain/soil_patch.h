@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "dem_mobility/core/terrain/dem_soil.h"
@@ -43,6 +44,16 @@ struct PatchSoilMeasure {
   double surface = std::numeric_limits<double>::quiet_NaN();  ///< [m] (scene z)
   int particles = 0;
   double reemitted_fraction = 0.0;  ///< of the particles counted: re-emitted ones
+};
+
+/// One check of the soil ahead of the front wheels (every check period once the patch follows).
+struct PatchCheck {
+  double t = 0.0;                   ///< [s] the soil's time
+  double front_x = 0.0;             ///< [m] the front wheels' centres (x)
+  double density_ratio = 0.0;       ///< the window's bulk density over the initial bed's
+  double surface_offset = 0.0;      ///< [m] its mean surface less the initial bed's
+  double reemitted_fraction = 0.0;  ///< of its particles: re-emitted ones (a check counts from 0.9)
+  int particles = 0;
 };
 
 /// What the patch has done so far.
@@ -59,7 +70,13 @@ struct PatchStats {
   double density_ratio_min = std::numeric_limits<double>::quiet_NaN(), density_ratio_max = std::numeric_limits<double>::quiet_NaN();
   double surface_offset_mean = std::numeric_limits<double>::quiet_NaN(); ///< [m] re-emitted - initial
   double surface_offset_max = std::numeric_limits<double>::quiet_NaN();  ///< largest |offset| [m]
+  std::vector<PatchCheck> log;    ///< every check made, those under 90 % re-emitted soil too
 };
+
+/// The patch's checks as CSV (t, front_x, density_ratio, surface_offset, reemitted_fraction,
+/// particles): what the soil ahead of the wheels was like along the run. ConfigError naming the
+/// path when it cannot be written.
+void WritePatchChecks(const PatchStats& s, const std::string& path);
 
 class SoilPatch {
  public:
