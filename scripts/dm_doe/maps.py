@@ -24,61 +24,48 @@ def speed_map(table, slope, ci, clamp_ci=False):
     return interp.bilinear(table['grades'], table['cone_indices'], table['speed'], slope, ci, clamp_ci=clamp_ci)
 
 
-def write_png(path, values, cell_size, title, vmax, label='speed-made-good [mph]', scale=1.0 / MPH):
-    """A picture of a map (values in m/s shown in mph by default): colour bar, scale bar, title;
-    cells without a value in grey."""
+def _map_picture(path, shown, cell_size, title, cmap_name, vmin, vmax, label, scale_bar=True):
+    """A map's picture: the cells (NaN grey, and said so), a colour bar, a scale bar, a title."""
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     from matplotlib import colormaps
-    ny, nx = values.shape
+    from matplotlib.patches import Patch
+    ny, nx = shown.shape
     w_km, h_km = nx * cell_size / 1e3, ny * cell_size / 1e3
     fig, ax = plt.subplots(figsize=(7.5, 7.5 * max(0.4, min(2.0, h_km / w_km)) + 0.6))
-    cmap = colormaps['RdYlGn'].copy()
+    cmap = colormaps[cmap_name].copy()
     cmap.set_bad('0.6')
-    im = ax.imshow(np.ma.masked_invalid(values * scale), cmap=cmap, vmin=0.0, vmax=vmax * scale,
-                   extent=(0, w_km, 0, h_km), origin='upper', interpolation='nearest')
+    im = ax.imshow(np.ma.masked_invalid(shown), cmap=cmap, vmin=vmin, vmax=vmax, extent=(0, w_km, 0, h_km),
+                   origin='upper', interpolation='nearest')
     fig.colorbar(im, ax=ax, label=label, shrink=0.85)
-    if np.isnan(values).any():
-        from matplotlib.patches import Patch
+    if np.isnan(shown).any():
         ax.legend(handles=[Patch(color='0.6', label='no value (beyond the table, or no data)')], loc='upper right',
                   fontsize=8, framealpha=0.8)
-    # a scale bar: a round length near a fifth of the width
-    bar = [b for b in (0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50) if b <= w_km / 4.0] or [w_km / 4.0]
-    b = bar[-1]
-    x0, y0 = 0.05 * w_km, 0.05 * h_km
-    ax.plot([x0, x0 + b], [y0, y0], color='k', lw=4, solid_capstyle='butt')
-    ax.text(x0 + b / 2, y0 + 0.02 * h_km, '%g km' % b, ha='center', va='bottom', fontsize=9,
-            bbox=dict(facecolor='white', alpha=0.7, lw=0))
+    if scale_bar:  # a round length near a quarter of the width
+        b = ([b for b in (0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50) if b <= w_km / 4.0] or [w_km / 4.0])[-1]
+        x0, y0 = 0.05 * w_km, 0.05 * h_km
+        ax.plot([x0, x0 + b], [y0, y0], color='k', lw=4, solid_capstyle='butt')
+        ax.text(x0 + b / 2, y0 + 0.02 * h_km, '%g km' % b, ha='center', va='bottom', fontsize=9,
+                bbox=dict(facecolor='white', alpha=0.7, lw=0))
     ax.set_xlabel('east [km]')
     ax.set_ylabel('north [km]')
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def write_png(path, values, cell_size, title, vmax, label='speed-made-good [mph]', scale=1.0 / MPH):
+    """A picture of a map (values in m/s shown in mph by default): colour bar, scale bar, title;
+    cells without a value in grey."""
+    _map_picture(path, values * scale, cell_size, title, 'RdYlGn', 0.0, vmax * scale, label)
 
 
 def write_difference_png(path, diff, cell_size, title):
     """A difference map (m/s, shown in mph) on a diverging scale centred on 0."""
-    import matplotlib
-    matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
-    from matplotlib import colormaps
-    ny, nx = diff.shape
-    w_km, h_km = nx * cell_size / 1e3, ny * cell_size / 1e3
     lim = float(np.nanmax(np.abs(diff))) / MPH if np.isfinite(diff).any() else 1.0
-    fig, ax = plt.subplots(figsize=(7.5, 7.5 * max(0.4, min(2.0, h_km / w_km)) + 0.6))
-    cmap = colormaps['RdBu'].copy()
-    cmap.set_bad('0.6')
-    im = ax.imshow(np.ma.masked_invalid(diff / MPH), cmap=cmap, vmin=-lim, vmax=lim,
-                   extent=(0, w_km, 0, h_km), origin='upper', interpolation='nearest')
-    fig.colorbar(im, ax=ax, label='difference [mph]', shrink=0.85)
-    ax.set_xlabel('east [km]')
-    ax.set_ylabel('north [km]')
-    ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _map_picture(path, diff / MPH, cell_size, title, 'RdBu', -max(lim, 1e-9), max(lim, 1e-9), 'difference [mph]')
 
 
 def write_ros_map(stem, values, geotransform, top_speed):
