@@ -266,7 +266,7 @@ void SoilPatch::PlaceTools(double velocity) {
 
 void SoilPatch::Check(double front_wheels_x) {
   const PatchSoilMeasure m = Measure(front_wheels_x + p_.check_from, front_wheels_x + p_.check_to);
-  if (m.particles == 0) return;
+  if (m.particles == 0 || !stats_.following) return;
   const double ratio = m.density / stats_.initial.density, offset = m.surface - stats_.initial.surface;
   stats_.log.push_back({bin_->dem().time(), front_wheels_x, ratio, offset, m.reemitted_fraction, m.particles});
   if (m.reemitted_fraction < 0.9) return;
