@@ -39,6 +39,16 @@ def numbers(text):
         raise argparse.ArgumentTypeError('expected numbers separated by commas, got %r' % text)
 
 
+def grid_size(text):
+    try:
+        g = [int(x) for x in text.lower().split('x')]
+    except ValueError:
+        g = []
+    if len(g) != 2 or min(g) < 2:
+        raise argparse.ArgumentTypeError('expected G x C with G, C >= 2 (e.g. 14x12), got %r' % text)
+    return g
+
+
 def commit():
     try:
         return subprocess.check_output(['git', '-C', ROOT, 'rev-parse', '--short', 'HEAD'], text=True,
@@ -47,17 +57,29 @@ def commit():
         return 'unknown'
 
 
+MAX_GRADE = 45.0  # [deg] the scenes' grade_deg range (mobility_run.cpp)
+
+
 def grid_of(a, slope=None, ci=None):
     """The grid: the paper's (default), or the ranges found on the map (--grid map: G x C values
     spanning the cells' slopes and CIs), or the given --grades and --cone-indices."""
     if a.grades is not None or a.cone_indices is not None:
         if a.grades is None or a.cone_indices is None:
             raise UsageError('give both --grades and --cone-indices (or neither)')
+        if a.grades and max(a.grades) > MAX_GRADE:
+            raise UsageError('--grades: %g deg is steeper than the scenes take (grade_deg up to %g deg)'
+                             % (max(a.grades), MAX_GRADE))
         return plan.Grid(a.grades, a.cone_indices)
     if getattr(a, 'grid', 'paper') == 'map':
         if slope is None:
             raise UsageError('--grid map needs the map (--elevation)')
+        if len(a.grid_size) != 2 or min(a.grid_size) < 2:
+            raise UsageError('--grid-size: expected G x C with G, C >= 2 (e.g. 14x12), got %r' % a.grid_size)
         s_max = float(np.nanmax(slope))
+        if s_max > MAX_GRADE:  # steeper cells are beyond the table: no value on the map
+            print('plan: the map\'s slopes reach %.1f deg; the grid stops at %g deg (the scenes\' limit)'
+                  % (s_max, MAX_GRADE))
+            s_max = MAX_GRADE
         c_lo, c_hi = float(np.nanmin(ci)), float(np.nanmax(ci))
         g = [round(s_max * k / (a.grid_size[0] - 1), 3) for k in range(a.grid_size[0])]
         c = [round(c_lo + (c_hi - c_lo) * k / (a.grid_size[1] - 1), 3) for k in range(a.grid_size[1])]
@@ -183,6 +205,9 @@ def cmd_map(a):
     speed = maps.speed_map(table, slope, ci, clamp_ci=a.clamp_ci)
     t_map = time.time() - t0
     top = float(np.nanmax(table['speed'])) if a.top_speed is None else a.top_speed
+    if not top > 0:
+        raise UsageError('the ROS map needs a top speed above 0 m/s (the table\'s highest is %g): give --top-speed'
+                         % float(np.nanmax(table['speed'])))
     label = table.get('model', 'physics')
     name = a.name or ('%s_smg' % label)
     title = '%s speed-made-good [mph], %d x %d cells of %g m; CI: %s' % (
@@ -267,13 +292,14 @@ def cmd_plan(a):
     if a.elevation:
         _, slope, ci, _ = cells_of(a)
     grid = grid_of(a, slope, ci)
-    if a.grades is None and a.cone_indices is None and a.grid == 'paper':
-        # the paper's CIs this level can simulate (and the road): a given CI outside is refused
+    if a.grades is None and a.cone_indices is None:
+        # the paper's (or the map's) CIs this level can simulate (and the road); a CI given with
+        # --cone-indices outside is refused
         lo, hi, table = level_ci_range(a.level)
         keep = [c for c in grid.cone_indices if lo <= c <= hi or c >= plan.ROAD_CONE_INDEX]
         dropped = [c for c in grid.cone_indices if c not in keep]
         if dropped:
-            print('plan: the paper\'s CI %s psi lie outside the %s level\'s table (%g-%g psi): left out'
+            print('plan: the grid\'s CI %s psi lie outside the %s level\'s table (%g-%g psi): left out'
                   % (', '.join('%g' % c for c in dropped), a.level, lo, hi))
         grid = plan.Grid(grid.grades, keep)
     lo, hi, table = check_cone_indices(grid, a.level)
@@ -329,7 +355,7 @@ def parser():
     map_args(p, required=False)
     p.add_argument('--grid', choices=('paper', 'map'), default='paper',
                    help='paper: 14 x 12 (default); map: --grid-size values over the ranges found on the map')
-    p.add_argument('--grid-size', type=lambda t: [int(x) for x in t.split('x')], default=[14, 12],
+    p.add_argument('--grid-size', type=grid_size, default=[14, 12],
                    help='G x C for --grid map (default 14x12)')
     p.add_argument('--level', default='tiny', help='soil fidelity level of the runs (default tiny)')
     p.set_defaults(func=cmd_plan)

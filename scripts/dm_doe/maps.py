@@ -75,6 +75,8 @@ def write_ros_map(stem, values, geotransform, top_speed):
     is 0, the rest 1-99; a cell without a value is transparent (alpha 0), which scale mode reads
     as unknown (-1)."""
     from PIL import Image
+    if not (np.isfinite(top_speed) and top_speed > 0):
+        raise ValueError('the ROS map\'s top speed must be a positive speed, got %r m/s' % top_speed)
     occ = np.clip(1.0 - values / top_speed, 0.0, 1.0)
     grey = np.where(np.isnan(values), 205, np.round(255.0 * (1.0 - np.nan_to_num(occ)))).astype(np.uint8)
     alpha = np.where(np.isnan(values), 0, 255).astype(np.uint8)

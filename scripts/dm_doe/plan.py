@@ -8,8 +8,8 @@ and no finished case contradicts that bound (a harder case that moved, for an im
 easier case that stayed under the command, for an implied command limit): where the bounds
 disagree (the simulated speeds are not monotone there, e.g. near a threshold), the case runs.
 
-The order brings those bounds early: a coarse grid first (every other grade and CI, then every
-fourth's complement ...: the bisection order of each axis), so that a stuck or command-limited
+The order brings those bounds early: a coarse grid first (each axis's ends, then its middle, then
+the middles of the halves ...: the bisection order of each axis), so that a stuck or command-limited
 coarse case fixes the finer cases around it before they come up. The order is fixed (it does not
 depend on the outcomes), so that a job array submitted at once (Slurm) runs the same cases in the
 same order as the local pool; a case is checked against the finished ones when its turn comes.

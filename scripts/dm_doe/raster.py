@@ -2,7 +2,10 @@
 the map's cells out (paper section 5, step 1), GeoTIFFs written with the input's CRS.
 
 - The map's grid: square cells of `cell_size` metres (20 by default) in the elevation raster's CRS,
-  from its top-left corner, covering it. A raster in geographic coordinates (degrees) is first
+  from its top-left corner; a strip narrower than a cell at the right and bottom edges is left
+  out. A post at the raster's edge has no neighbour on one side: its slope has no value, so an
+  edge cell takes its largest slope from its inner posts (with --oversample 1 the outer ring of
+  cells has none). A raster in geographic coordinates (degrees) is first
   warped to the UTM zone of its centre (WGS 84), so that slopes and cells are in metres; one with no
   CRS at all is refused.
 - Per cell, the maximum positive slope: the elevation is resampled (bilinear) to `oversample` x
@@ -85,6 +88,9 @@ def read(path, what='raster'):
     gt = ds.GetGeoTransform()
     if gt[2] != 0 or gt[4] != 0:
         raise RasterError('%s: the %s grid is rotated (geotransform %s); warp it first (gdalwarp)' % (path, what, gt))
+    if gt[1] <= 0 or gt[5] >= 0:
+        raise RasterError('%s: the %s is not north-up (pixel size %g x %g); warp it first (gdalwarp)'
+                          % (path, what, gt[1], gt[5]))
     b = ds.GetRasterBand(1)
     v = b.ReadAsArray().astype(np.float64)
     nd = b.GetNoDataValue()

@@ -77,6 +77,16 @@ class Doe(unittest.TestCase):
         self.assertIn('every case run:', out)
         self.assertIn('with pruning:', out)
 
+    def test_a_map_grid_spans_the_map_within_what_the_level_and_the_scenes_take(self):
+        rc, out, se = doe('plan', '--grid', 'map', '--grid-size', '5x4', '--elevation', ST_HELENS, '--level', 'tiny')
+        self.assertEqual(rc, 0, se)
+        self.assertIn('the grid stops at 45 deg', out)     # St. Helens' crater walls are steeper
+        self.assertIn('5 grades (0, 11.25, 22.5, 33.75, 45)', out)
+        self.assertIn('left out', out)                     # generated CIs above the tiny table
+        rc, _, err = doe('plan', '--grid', 'map', '--grid-size', '14', '--elevation', ST_HELENS)
+        self.assertEqual(rc, 2)
+        self.assertIn('--grid-size', err)
+
     def test_bad_input_is_refused_naming_it(self):
         bare = os.path.join(self.tmp, 'bare.tif')
         raster.write_geotiff(bare, np.zeros((5, 5)), (0, 30.0, 0, 0, 0, -30.0), '')
@@ -86,6 +96,16 @@ class Doe(unittest.TestCase):
         rc, _, err = doe('plan', '--grades', '', '--cone-indices', '30')
         self.assertEqual(rc, 2)
         self.assertIn('empty grid', err)
+        south_up = os.path.join(self.tmp, 'south_up.tif')
+        srs = osr.SpatialReference()
+        srs.ImportFromEPSG(32611)
+        raster.write_geotiff(south_up, np.zeros((5, 5)), (0, 30.0, 0, 0, 0, 30.0), srs.ExportToWkt())
+        rc, _, err = doe('plan', '--elevation', south_up)
+        self.assertEqual(rc, 2)
+        self.assertIn('not north-up', err)
+        rc, _, err = doe('plan', '--grades', '0,50', '--cone-indices', '30')
+        self.assertEqual(rc, 2)
+        self.assertIn('steeper than the scenes take', err)
         rc, _, err = doe('plan', '--level', 'tiny', '--grades', '0,12', '--cone-indices', '30,200')
         self.assertEqual(rc, 2)
         self.assertIn('cone index 200 psi: outside the tiny level', err)
