@@ -34,24 +34,11 @@ import yaml
 # dm_sweep lives beside this script (also when run through catkin's relay in devel/lib)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import dm_sweep  # noqa: E402
+from dm_sweep.args import floats, git_commit, ints  # noqa: E402
 
 PAPER_TABLE = [(30, 0.06), (40, 0.15), (50, 0.5), (60, 0.84), (70, 1.18), (80, 1.52), (100, 2.24),
                (120, 3.03), (150, 4.46), (200, 7.85), (242, 12.1)]
 PAPER_CUBIC = [9.148e-7, -1.783e-4, 4.555e-2, -1.445]
-
-
-def floats(text):
-    try:
-        return [float(v) for v in text.split(',') if v.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError('expected a comma-separated list of numbers, got %r' % text)
-
-
-def ints(text):
-    try:
-        return [int(v) for v in text.split(',') if v.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError('expected a comma-separated list of whole numbers, got %r' % text)
 
 
 def seeds_at(text):
@@ -110,18 +97,6 @@ def sha256(path):
         for block in iter(lambda: fh.read(1 << 16), b''):
             h.update(block)
     return h.hexdigest()
-
-
-def git_commit(root):
-    """The checkout's commit, with '-dirty' when tracked files differ from it."""
-    try:
-        head = subprocess.run(['git', '-C', root, 'rev-parse', 'HEAD'], stdout=subprocess.PIPE,
-                              stderr=subprocess.DEVNULL, universal_newlines=True, check=True).stdout.strip()
-        dirty = subprocess.run(['git', '-C', root, 'diff', '--quiet', 'HEAD', '--'],
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode != 0
-        return head + ('-dirty' if dirty else '')
-    except (OSError, subprocess.CalledProcessError):
-        return 'unknown (not a git checkout)'
 
 
 def scene_level(scene, fidelity):

@@ -40,6 +40,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import dm_sweep  # noqa: E402
 from dm_sweep import wheel_numerics as wn  # noqa: E402
+from dm_sweep.args import floats  # noqa: E402
 from dm_sweep.wheel_plots import plots, soil_label  # noqa: E402,F401
 
 ROOT = os.path.dirname(HERE)
@@ -54,13 +55,6 @@ WES_TEXT = ('WES clay numeric (4.2) not in the band: no closed-form pull in the 
             'and N_c = 0 for a rigid tire (its N_c at delta/h 0.15 is in summary.yaml)')
 GT_TEXT = ('T/(W r) compared with the gross traction GT/W = DP/W + MR/W: the empirical GT is the '
            'drive torque over the rolling radius, which for a rigid wheel is taken as its radius r')
-
-
-def floats(text):
-    try:
-        return [float(v) for v in text.split(',') if v.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError('expected a comma-separated list of numbers, got %r' % text)
 
 
 # -- the cases

@@ -10,14 +10,14 @@ a level can simulate) is refused naming the input, with exit status 2.
 import argparse
 import csv
 import datetime
-import math
 import os
-import subprocess
 import sys
 import time
 
 import numpy as np
 import yaml
+
+from dm_sweep.args import floats, git_commit
 
 from . import maps, nrmm, plan, raster
 
@@ -32,13 +32,6 @@ class UsageError(ValueError):
     pass
 
 
-def numbers(text):
-    try:
-        return [float(x) for x in text.split(',') if x.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError('expected numbers separated by commas, got %r' % text)
-
-
 def grid_size(text):
     try:
         g = [int(x) for x in text.lower().split('x')]
@@ -47,14 +40,6 @@ def grid_size(text):
     if len(g) != 2 or min(g) < 2:
         raise argparse.ArgumentTypeError('expected G x C with G, C >= 2 (e.g. 14x12), got %r' % text)
     return g
-
-
-def commit():
-    try:
-        return subprocess.check_output(['git', '-C', ROOT, 'rev-parse', '--short', 'HEAD'], text=True,
-                                       stderr=subprocess.DEVNULL).strip()
-    except (OSError, subprocess.CalledProcessError):
-        return 'unknown'
 
 
 MAX_GRADE = 45.0  # [deg] the scenes' grade_deg range (mobility_run.cpp)
@@ -179,7 +164,7 @@ def cmd_nrmm(a):
             rows.append({'grade_deg': g, 'cone_index': c, 'speed_made_good': round(r['speed'], 6),
                          'speed_made_good_mph': round(r['speed'] / maps.MPH, 4), 'status': r['status'],
                          'source': 'nrmm (%s)' % r['limit']})
-    prov = {'model': 'nrmm', 'vehicle': os.path.abspath(a.vehicle), 'commit': commit(),
+    prov = {'model': 'nrmm', 'vehicle': os.path.abspath(a.vehicle), 'commit': git_commit(ROOT),
             'made': datetime.datetime.utcnow().strftime('%Y-%m-%dT%H:%MZ'),
             'mobility_index': round(v.mobility_index(), 3), 'vci1_psi': round(v.vci1(), 3),
             'vci50_psi': round(v.vci50(), 3),
@@ -336,8 +321,8 @@ def parser():
     sub.required = True
 
     def grid_args(p):
-        p.add_argument('--grades', type=numbers, help='grades [deg], rising (default: the paper\'s 0, 3, ..., 39)')
-        p.add_argument('--cone-indices', type=numbers,
+        p.add_argument('--grades', type=floats, help='grades [deg], rising (default: the paper\'s 0, 3, ..., 39)')
+        p.add_argument('--cone-indices', type=floats,
                        help='cone indices [psi], rising (default: the paper\'s 12 of table 3, 30-300)')
 
     def map_args(p, required=True):
