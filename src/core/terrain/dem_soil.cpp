@@ -383,6 +383,7 @@ void DemSoilTerrain::Describe(ResultFile* r) const {
   r->Set("patch_strays", s.strays);
   r->Set("patch_template_copies", s.copies);
   r->Set("patch_skipped_sites", s.skipped_sites);
+  r->Set("patch_face_setback", s.face_setback);
   r->Set("patch_initial_density", s.initial.density);
   r->Set("patch_initial_surface", s.initial.surface);
   r->Set("patch_checks", s.checks);

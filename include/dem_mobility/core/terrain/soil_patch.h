@@ -62,6 +62,10 @@ struct PatchStats {
   long strays = 0;                ///< of those, strays from the emitter's zone
   long skipped_sites = 0;         ///< template sites skipped: soil already there
   int copies = 0;                 ///< template copies begun
+  /// [m] how far the bed's face (its columns' median foremost particle) stood behind where the
+  /// front wall held it (half a diameter inside it) when the first copy was laid against it: the
+  /// bed's slump down a grade (NaN until the first copy)
+  double face_setback = std::numeric_limits<double>::quiet_NaN();
   bool following = false;
   PatchSoilMeasure initial;       ///< the bed ahead of the front wheels when the patch starts to follow
   // the checks with at least 90 % re-emitted soil in the window
