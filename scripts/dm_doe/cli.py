@@ -1,6 +1,8 @@
 """`doe`: the design of experiments over grade x cone index, from a raster to a map (docs/doe.md).
 
-    doe plan  --elevation DEM.tif [--ci CI.tif | --ci-seed N] --level tiny --out DIR
+    doe plan  --elevation DEM.tif [--ci CI.tif | --ci-seed N] --level tiny
+    doe run   --out DIR [--grades ... --cone-indices ...] --level tiny --jobs 2 [--resume] [--dry-run]
+    doe status --out DIR
     doe nrmm  --out DIR [--grades ... --cone-indices ...]
     doe map   --table TABLE.yaml --elevation DEM.tif [--ci CI.tif | --ci-seed N] --out DIR [--compare OTHER.yaml]
 
@@ -19,13 +21,16 @@ import yaml
 
 from dm_sweep.args import floats, git_commit
 
-from . import maps, nrmm, plan, raster
+import dm_sweep
+
+from . import maps, nrmm, plan, raster, runner
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 CONFIG = os.path.join(ROOT, 'config')
 NRMM_VEHICLE = os.path.join(CONFIG, 'vehicles', 'hmmwv', 'nrmm.yaml')
 COSTS = os.path.join(CONFIG, 'doe', 'run_costs.yaml')
+DOE_SCRIPT = os.path.join(ROOT, 'scripts', 'doe')
 
 
 class UsageError(ValueError):
@@ -267,7 +272,11 @@ def run_cost(costs, level, status, ci, road_ci=plan.ROAD_CONE_INDEX):
     return c['prepare'] + sim * c['wall_per_sim_s']
 
 
-def cmd_plan(a):
+def design(a):
+    """(grid, costs, prior, (lo, hi, table)) of a plan or run: the grid (the paper's or the map's
+    CIs that the level can simulate, and the road; CIs given with --cone-indices outside the
+    level's table are refused), the measured run costs, and the NRMM model standing in for the
+    outcomes."""
     with open(COSTS) as fh:
         costs = yaml.safe_load(fh)
     if a.level not in costs['levels']:
@@ -278,8 +287,6 @@ def cmd_plan(a):
         _, slope, ci, _ = cells_of(a)
     grid = grid_of(a, slope, ci)
     if a.grades is None and a.cone_indices is None:
-        # the paper's (or the map's) CIs this level can simulate (and the road); a CI given with
-        # --cone-indices outside is refused
         lo, hi, table = level_ci_range(a.level)
         keep = [c for c in grid.cone_indices if lo <= c <= hi or c >= plan.ROAD_CONE_INDEX]
         dropped = [c for c in grid.cone_indices if c not in keep]
@@ -287,12 +294,17 @@ def cmd_plan(a):
             print('plan: the grid\'s CI %s psi lie outside the %s level\'s table (%g-%g psi): left out'
                   % (', '.join('%g' % c for c in dropped), a.level, lo, hi))
         grid = plan.Grid(grid.grades, keep)
-    lo, hi, table = check_cone_indices(grid, a.level)
+    limits = check_cone_indices(grid, a.level)
     v = nrmm.Vehicle.load(NRMM_VEHICLE)
 
     def prior(cell):  # the NRMM model stands in for the outcomes the runs will have
         r = v.speed(grid.grades[cell[0]], grid.cone_indices[cell[1]])
         return r['status'], r['speed']
+    return grid, costs, prior, limits
+
+
+def print_plan(a, grid, costs, prior, limits):
+    lo, hi, table = limits
     sim, imp = plan.replay(grid, prior)
     full = sum(run_cost(costs, a.level, prior(c)[0], grid.cone_indices[c[1]]) for c in grid.cells())
     pruned = sum(run_cost(costs, a.level, s, grid.cone_indices[c[1]]) for c, s, _ in sim)
@@ -310,7 +322,113 @@ def cmd_plan(a):
     print('    with pruning:          %7.1f h (%d runs, %d implied by their neighbours)' % (
         pruned / 3600, len(sim), len(imp)))
     print('  (the pruning the runs allow depends on their outcomes: the figures are an estimate)')
+
+
+def cmd_plan(a):
+    print_plan(a, *design(a))
     return 0
+
+
+# -- run, status, case ------------------------------------------------------------------------
+
+def cmd_run(a):
+    if a.jobs < 1:
+        raise UsageError('--jobs %d: at least 1' % a.jobs)
+    if a.dem_threads < 1:
+        raise UsageError('--dem-threads %d: at least 1' % a.dem_threads)
+    if a.duration is not None and not 0 < a.duration <= 40.0:
+        raise UsageError('--duration %g: the driving time is in (0, 40] s (the paper\'s run is 40 s)' % a.duration)
+    grid, costs, prior, limits = design(a)
+    cells = {(grid.grades[i], grid.cone_indices[j]): (i, j) for i, j in grid.cells()}
+
+    def cost_of(g, c):
+        return run_cost(costs, a.level, prior(cells[(g, c)])[0], c)
+    prov = {'nrmm_prior': NRMM_VEHICLE, 'costs': COSTS, 'calibration_table': os.path.relpath(limits[2], ROOT)}
+    if a.elevation:
+        prov['elevation'] = os.path.abspath(a.elevation)
+    doc = runner.make_plan(grid, a.level, a.runner, a.dem_threads, a.duration, not a.no_prune, cost_of, prov)
+    path = os.path.join(a.out, runner.PLAN_FILE)
+    if os.path.exists(path):
+        old = runner.load_plan(a.out)
+        if not a.resume:
+            raise UsageError('%s holds a DOE already: --resume to go on with it, or another --out' % a.out)
+        diff = runner.same_design(old, doc)
+        if diff:
+            raise UsageError('%s holds another DOE (%s): --resume takes the same grid, level and runner' % (a.out, diff))
+        doc = old
+    elif a.resume:
+        raise UsageError('--resume: %s holds no DOE (%s)' % (a.out, path))
+    print_plan(a, grid, costs, prior, limits)
+    if a.dry_run:
+        print('dry run: nothing run')
+        return 0
+    os.makedirs(runner.runs_dir(a.out), exist_ok=True)
+    if not os.path.exists(path):
+        runner.write_yaml(path, doc)
+    states = runner.scan(a.out, doc)
+    for k, (s, r) in states.items():
+        if s == 'running':
+            raise UsageError('case %s is running (runs/%s.running): another doe run on %s?' % (
+                doc['cases'][k]['name'], doc['cases'][k]['name'], a.out))
+    failed = [c for c in doc['cases'] if states[c['index']][0] == 'failed']
+    todo = [c for c in doc['cases'] if states[c['index']][0] == 'pending' or (a.retry_failed and c in failed)]
+    for c in failed:
+        if not a.retry_failed:
+            print('failed before: %s: %s (--retry-failed runs it again)' % (
+                c['name'], (states[c['index']][1] or {}).get('error') or 'no result'))
+    print('doe: %d cases: %d done, %d to run (%d at a time, runner %s)' % (
+        len(doc['cases']), len(doc['cases']) - len(todo) - (0 if a.retry_failed else len(failed)), len(todo), a.jobs,
+        a.runner))
+    interrupted = False
+    if todo:
+        by_index = {c['index']: c for c in doc['cases']}
+        cases = dm_sweep.cases([{'index': c['index']} for c in todo], name=lambda p: by_index[p['index']]['name'])
+
+        def describe(o):
+            if not o.ok:
+                return 'FAILED: %s' % o.error
+            r = o.result
+            if r.get('status') == runner.IMPLIED:
+                return 'implied %s by %s' % (r['implied_status'], r['implied_by'])
+            return '%s %.3f m/s' % (r.get('status'), float(r.get('speed_made_good') or 0.0))
+        command = [sys.executable, DOE_SCRIPT, 'case', '--out', os.path.abspath(a.out), '--index', '{index}',
+                   '--port', '{port}']
+        sweep = dm_sweep.Sweep(
+            cases, command, os.path.join(a.out, 'workers'), jobs=a.jobs, port=a.port, timeout=a.timeout,
+            check=lambda case, r: runner.verdict(by_index[case['index']], r), accept_status=(runner.IMPLIED,),
+            result_of=lambda case: runner.result_path(a.out, by_index[case['index']]),
+            weight=lambda case: by_index[case['index']]['estimated_cost'], describe=describe,
+            progress=a.progress, status_every=None)
+        try:
+            sweep.run()
+        except KeyboardInterrupt:
+            interrupted = True
+    states = runner.scan(a.out, doc)
+    rows = runner.table_rows(a.out, doc, states)
+    table, summary = runner.write_doe_table(a.out, doc, rows)
+    speed = np.array([[np.nan if v is None else v for v in row] for row in summary['speed']], dtype=float)
+    speed_plots(a.out, 'doe', grid, speed, 'speed-made-good, level %s (%d simulated, %d implied)' % (
+        a.level, summary['simulated'], summary['implied']))
+    print(runner.status_text(a.out, doc, states, a.jobs))
+    print('doe: table %s; %d of %d runs saved by pruning' % (table, summary['implied'], summary['cases']))
+    if interrupted:
+        print('doe: interrupted; doe run --resume --out %s goes on' % a.out, file=sys.stderr)
+        return 130
+    return 1 if summary['failed'] or summary['not_run'] else 0
+
+
+def cmd_status(a):
+    doc = runner.load_plan(a.out)
+    states = runner.scan(a.out, doc)
+    print(runner.status_text(a.out, doc, states, a.jobs))
+    if a.table:
+        path, _ = runner.write_doe_table(a.out, doc, runner.table_rows(a.out, doc, states))
+        print('table: %s' % path)
+    return 0
+
+
+def cmd_case(a):
+    return runner.run_case(a.out, a.index, a.port)
 
 
 # -- the command line -------------------------------------------------------------------------
@@ -345,6 +463,52 @@ def parser():
     p.add_argument('--level', default='tiny', help='soil fidelity level of the runs (default tiny)')
     p.set_defaults(func=cmd_plan)
 
+    p = sub.add_parser('run', help='runs the DOE\'s cases on a local pool (resume, pruning, table and plots)',
+                       description='Runs every case of the design (the plan as doe plan prints it) through the '
+                       'same launch files and nodelets a user runs (soil_slope.launch; road_slope.launch for CI 300), '
+                       '--jobs at a time, in the plan\'s order; a case whose outcome the finished ones fix is '
+                       'recorded as implied, not run. Writes OUT/doe.yaml, OUT/runs/ (a result, log and bag per '
+                       'case), OUT/doe_table.csv/.yaml and the plots. --resume keeps the finished cases.')
+    grid_args(p)
+    map_args(p, required=False)
+    p.add_argument('--grid', choices=('paper', 'map'), default='paper',
+                   help='paper: 14 x 12 (default); map: --grid-size values over the ranges found on the map')
+    p.add_argument('--grid-size', type=grid_size, default=[14, 12], help='G x C for --grid map (default 14x12)')
+    p.add_argument('--level', default='tiny', help='soil fidelity level of the runs (default tiny)')
+    p.add_argument('--runner', choices=('roslaunch', 'core'), default='roslaunch',
+                   help='roslaunch (default: the launch files, a bag per case) or core (build/core\'s dm_run_scene: '
+                   'the same loop in one process, no bag)')
+    p.add_argument('--jobs', type=int, default=1, help='cases at a time (default 1)')
+    p.add_argument('--dem-threads', type=int, default=1, help='soil threads of each run (default 1)')
+    p.add_argument('--duration', type=float, help='longest driving time [s] (default: the scenes\' 40 s)')
+    p.add_argument('--no-prune', action='store_true', help='run every case (no implied cases)')
+    p.add_argument('--resume', action='store_true', help='go on with the DOE in --out: finished cases are kept')
+    p.add_argument('--retry-failed', action='store_true', help='with --resume: run the failed cases again')
+    p.add_argument('--dry-run', action='store_true', help='print the plan and its estimated cost, run nothing')
+    p.add_argument('--timeout', type=float, help='longest a case may take [s]')
+    p.add_argument('--port', type=int, default=11611, help='first ROS master port of the pool (default 11611)')
+    p.add_argument('--progress', choices=('auto', 'tqdm', 'plain'), default='auto',
+                   help='a progress bar (tqdm, in s of estimated cost) on a terminal; plain: lines only')
+    p.add_argument('--out', required=True, help='the DOE folder')
+    p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser('status', help='what the DOE in a folder has done: cases simulated, implied, failed, left; ETA',
+                       description='Prints the state of every case of the DOE in --out (from its files: it works '
+                       'while a doe run is going on), the failed ones with their error, and the ETA.')
+    p.add_argument('--out', required=True, help='the DOE folder')
+    p.add_argument('--jobs', type=int, default=1, help='cases at a time, for the ETA (default 1)')
+    p.add_argument('--table', action='store_true', help='also write the case table as it stands')
+    p.set_defaults(func=cmd_status)
+
+    p = sub.add_parser('case', help='one case\'s turn (what doe run\'s pool and a Slurm array task run)',
+                       description='Runs case --index of the DOE in --out, unless it is done or the finished cases '
+                       'fix its outcome (then it is recorded as implied). Exit status 0 when the case is done, 1 '
+                       'when its run failed.')
+    p.add_argument('--out', required=True, help='the DOE folder')
+    p.add_argument('--index', type=int, required=True, help='the case\'s place in the plan\'s order')
+    p.add_argument('--port', type=int, help='ROS master port (default: ROS_MASTER_URI\'s, else 11611)')
+    p.set_defaults(func=cmd_case)
+
     p = sub.add_parser('nrmm', help='the NRMM-style speed table on the grid, with its plots',
                        description='Writes the NRMM-style model\'s speed-made-good table (CSV, YAML) on the grid '
                        'and its plots against CI per grade and against grade per CI (docs/doe.md).')
@@ -373,6 +537,6 @@ def main(argv=None):
     a = ap.parse_args(argv)
     try:
         return a.func(a)
-    except (UsageError, plan.PlanError, nrmm.NrmmError, raster.RasterError) as e:
+    except (UsageError, plan.PlanError, nrmm.NrmmError, raster.RasterError, runner.RunnerError) as e:
         print('doe %s: %s' % (a.command, e), file=sys.stderr)
         return 2

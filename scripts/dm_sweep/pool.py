@@ -111,6 +111,10 @@ class Sweep:
     env: extra environment variables (a dict, or a callable (case, outcome) -> dict).
     describe: callable outcome -> the text after a finished run's name (default 'ok' or
       'FAILED: <error>').
+    result_of: callable case -> the path of its result file (default <runs_dir>/<name>.result.yaml).
+    weight: callable case -> its estimated cost [s] (default 1 each): the progress bar counts in it
+      and each finished run's line gives an ETA (the weight left, at the rate of the weight done so
+      far in this sweep).
     progress: 'auto', 'tqdm' or 'plain' (see dm_sweep.progress); poll: seconds between checks;
       status_every: seconds between the lines of the running runs' progress (None: never), read
       from their logs after `progress_marker`.
@@ -118,7 +122,8 @@ class Sweep:
 
     def __init__(self, cases, command, runs_dir, jobs=1, port=11411, timeout=None, check=None, outputs=None,
                  env=None, describe=None, progress='auto', poll=1.0, status_every=20.0,
-                 progress_marker='progress:', kill_grace=30.0, stream=None, accept_status=()):
+                 progress_marker='progress:', kill_grace=30.0, stream=None, accept_status=(), result_of=None,
+                 weight=None):
         if jobs < 1:
             raise ValueError('jobs must be >= 1')
         self.accept_status = tuple(accept_status)
@@ -144,12 +149,17 @@ class Sweep:
         self.kill_grace = kill_grace
         self.stream = stream
         self.t0 = None
+        self.result_of = result_of
+        self.weighted = weight is not None
+        self.weight = weight or (lambda case: 1.0)
         self.outcomes = [Outcome(c, self.result_path(c), self.log_path(c)) for c in self.cases]
         self._progress = None
         os.makedirs(runs_dir, exist_ok=True)
 
     # -- files and verdicts
     def result_path(self, case):
+        if self.result_of is not None:
+            return self.result_of(case)
         return os.path.join(self.runs_dir, case.name + '.result.yaml')
 
     def log_path(self, case):
@@ -284,7 +294,11 @@ class Sweep:
         finished = len(self.outcomes) - len(pending)
         ports = [self.port + 2 * k for k in range(self.jobs)]
         last_status = 0.0
-        self._progress = Progress(len(self.outcomes), finished, self.progress_mode, self.stream)
+        w_all = sum(self.weight(o.case) for o in self.outcomes)
+        w_left = sum(self.weight(o.case) for o in pending)
+        w_done = 0.0
+        self._progress = Progress(w_all, w_all - w_left, self.progress_mode, self.stream,
+                                  unit='s' if self.weighted else 'run')
         try:
             while pending or running:
                 while pending and len(running) < self.jobs:
@@ -306,10 +320,16 @@ class Sweep:
                     running.remove(o)
                     ports.append(o.slot)
                     finished += 1
-                    self._progress.advance()
-                    self.line('[%6.0f s] done   %-14s %s (%.0f s)  [%d/%d]' %
+                    w = self.weight(o.case)
+                    w_done += w
+                    w_left -= w
+                    self._progress.advance(w)
+                    eta = ''
+                    if w_left > 0 and w_done > 0:
+                        eta = '  ETA ~%.0f min' % ((time.time() - self.t0) * w_left / w_done / 60.0)
+                    self.line('[%6.0f s] done   %-14s %s (%.0f s)  [%d/%d]%s' %
                               (time.time() - self.t0, o.name, self.describe(o), o.end - o.start, finished,
-                               len(self.outcomes)))
+                               len(self.outcomes), eta))
                 if running and self.status_every is not None and time.time() - last_status > self.status_every:
                     last_status = time.time()
                     for o in running:

@@ -17,14 +17,14 @@ class Progress:
     """mode: 'auto' (a bar if tqdm is importable and stderr a terminal), 'tqdm' (a bar if tqdm is
     importable), 'plain' (lines only)."""
 
-    def __init__(self, total, initial=0, mode='auto', stream=None):
+    def __init__(self, total, initial=0, mode='auto', stream=None, unit='run'):
         if mode not in ('auto', 'tqdm', 'plain'):
             raise ValueError('progress mode %r: expected auto, tqdm or plain' % mode)
         self.stream = stream
         self.bar = None
         tqdm = load_tqdm() if mode != 'plain' else None
         if tqdm is not None and (mode == 'tqdm' or _isatty(sys.stderr)):
-            self.bar = tqdm(total=total, initial=initial, unit='run', file=sys.stderr)
+            self.bar = tqdm(total=total, initial=initial, unit=unit, file=sys.stderr)
 
     def line(self, text):
         out = self.stream or sys.stdout
@@ -34,9 +34,9 @@ class Progress:
         else:
             print(text, file=out, flush=True)
 
-    def advance(self):
+    def advance(self, n=1):
         if self.bar is not None:
-            self.bar.update(1)
+            self.bar.update(n)
 
     def close(self):
         if self.bar is not None:

@@ -1,0 +1,169 @@
+"""Tests of `doe run`, `doe status` and `doe case` (scripts/dm_doe/runner.py) on the local pool with
+real runs: road cases through the core runner (build/core's dm_run_scene, about 9 s each), where the
+outcomes are known from the power balance (the rigid road at 0-2 deg: the vehicle reaches the
+25 m/s command), so the pruning, resume and retry can be checked against them; and the worker's
+decisions (implied or run, with cases in flight) on made-up states.
+
+    DM_RUN_SCENE=build/core/src/core/dm_run_scene python3 test/python/test_doe_run.py
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, 'scripts'))
+from dm_doe import cli, plan, runner  # noqa: E402
+
+DOE = os.path.join(ROOT, 'scripts', 'doe')
+DM_RUN_SCENE = os.environ.get('DM_RUN_SCENE', os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene'))
+
+
+def doe(*args, env=None):
+    e = dict(os.environ, DM_RUN_SCENE=DM_RUN_SCENE)
+    e.update(env or {})
+    p = subprocess.run([sys.executable, DOE] + list(args), capture_output=True, text=True, env=e)
+    return p.returncode, p.stdout, p.stderr
+
+
+def load(path):
+    with open(path) as fh:
+        return yaml.safe_load(fh)
+
+
+class Decisions(unittest.TestCase):
+    """runner.decide on made-up states: a 3 x 3 grid (grades 0, 10, 20 x CI 50, 100, 150)."""
+
+    def setUp(self):
+        grid = plan.Grid([0.0, 10.0, 20.0], [50.0, 100.0, 150.0])
+        self.doc = runner.make_plan(grid, 'tiny', 'core', 1, None, True, lambda g, c: 100.0)
+        self.by_cell = {tuple(c['cell']): c for c in self.doc['cases']}
+
+    def states(self, **given):
+        """cell name 'i_j' -> (state, result); the others pending."""
+        s = {c['index']: ('pending', None) for c in self.doc['cases']}
+        for key, (state, status, speed) in given.items():
+            i, j = (int(x) for x in key[1:].split('_'))
+            s[self.by_cell[(i, j)]['index']] = (state, {'status': status, 'speed_made_good': speed})
+        return s
+
+    def test_a_stuck_easier_case_implies_no_go(self):
+        # (10 deg, CI 100) stuck: (20 deg, CI 50) is harder, so stuck too
+        st = self.states(c1_1=('simulated', 'no_go', 0.0))
+        x = runner.decide(self.by_cell[(2, 0)], self.doc, st)
+        self.assertEqual((x[0], x[1], x[2]['name']), (plan.NO_GO, 0.0, 'g10_ci100'))
+        # not an easier one
+        self.assertIsNone(runner.decide(self.by_cell[(0, 2)], self.doc, st))
+
+    def test_a_harder_case_in_flight_makes_it_run(self):
+        # (20 deg, CI 100) is implied no_go by (10 deg, CI 100); but a run in flight at (20 deg,
+        # CI 50), harder than it, could still move and contradict the bound: the case runs
+        st = self.states(c1_1=('simulated', 'no_go', 0.0), c2_0=('running', None, 0.0))
+        self.assertIsNone(runner.decide(self.by_cell[(2, 1)], self.doc, st))
+        # an easier case in flight cannot contradict a no-go bound
+        st = self.states(c1_1=('simulated', 'no_go', 0.0), c0_2=('running', None, 0.0))
+        self.assertEqual(runner.decide(self.by_cell[(2, 1)], self.doc, st)[0], plan.NO_GO)
+
+    def test_command_limited_bounds_the_easier_cases_from_below(self):
+        st = self.states(c2_0=('simulated', 'command_limited', 24.9))
+        x = runner.decide(self.by_cell[(1, 1)], self.doc, st)
+        self.assertEqual((x[0], x[1]), (plan.COMMAND_LIMITED, 24.9))
+        # an easier case in flight could still fall short of the command
+        st = self.states(c2_0=('simulated', 'command_limited', 24.9), c0_2=('running', None, 0.0))
+        self.assertIsNone(runner.decide(self.by_cell[(1, 1)], self.doc, st))
+
+    def test_implied_cases_never_bound_others_and_no_prune_runs_everything(self):
+        st = self.states(c1_1=('implied', 'no_go', 0.0))
+        self.assertIsNone(runner.decide(self.by_cell[(2, 0)], self.doc, st))
+        self.doc['prune'] = False
+        st = self.states(c1_1=('simulated', 'no_go', 0.0))
+        self.assertIsNone(runner.decide(self.by_cell[(2, 0)], self.doc, st))
+
+
+@unittest.skipUnless(os.access(DM_RUN_SCENE, os.X_OK), 'no dm_run_scene at %s (build the core first)' % DM_RUN_SCENE)
+class RoadDoe(unittest.TestCase):
+    """A 3 x 1 DOE on the rigid road (grades 0, 1, 2 deg, CI 300): the plan runs 0 and 2 deg first
+    (the axis's ends); 2 deg reaches the 25 m/s command, which bounds 1 deg from below: implied."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.mkdtemp(prefix='dm_doe_run_')
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_pruned_road_doe_then_resume_then_failures_and_retry(self):
+        out = os.path.join(self.tmp, 'road')
+        grid = ['--grades', '0,1,2', '--cone-indices', '300', '--runner', 'core', '--progress', 'plain']
+        rc, so, se = doe('run', '--out', out, *grid)
+        self.assertEqual(rc, 0, so + se)
+        t = load(os.path.join(out, 'doe_table.yaml'))
+        self.assertEqual((t['cases'], t['simulated'], t['implied'], t['runs_saved'], t['failed']), (3, 2, 1, 1, 0))
+        rows = {r['grade_deg']: r for r in t['cases_table']}
+        # the power balance: on 0-2 deg the road vehicle reaches the 25 m/s command
+        for g in (0.0, 2.0):
+            self.assertEqual(rows[g]['state'], 'simulated')
+            self.assertEqual(rows[g]['status'], 'command_limited')
+            self.assertAlmostEqual(rows[g]['speed_made_good'], 25.0, delta=0.05)
+        self.assertEqual(rows[1.0]['state'], 'implied')
+        self.assertEqual(rows[1.0]['source'], 'implied by g2_ci300')
+        self.assertEqual(rows[1.0]['speed_made_good'], rows[2.0]['speed_made_good'])
+        implied = load(os.path.join(out, 'runs', 'g1_ci300.result.yaml'))
+        self.assertEqual((implied['status'], implied['simulated'], implied['implied_status']),
+                         ('implied', False, 'command_limited'))
+        self.assertFalse(os.path.exists(os.path.join(out, 'runs', 'g1_ci300.log')))  # never run
+        self.assertTrue(load(os.path.join(out, 'runs', 'g0_ci300.provenance.yaml'))['commit'])
+        self.assertEqual(t['speed'], [[rows[g]['speed_made_good']] for g in (0.0, 1.0, 2.0)])
+        for f in ('doe_table.csv', 'doe_speed_vs_ci.png', 'doe_speed_vs_grade.png'):
+            self.assertGreater(os.path.getsize(os.path.join(out, f)), 100, f)
+        # the table is one `doe map` reads
+        self.assertEqual(cli.read_table(os.path.join(out, 'doe_table.yaml'))['speed'].shape, (3, 1))
+        rc, so, _ = doe('status', '--out', out)
+        self.assertEqual(rc, 0)
+        self.assertIn('simulated 2, implied 1 (runs saved), failed 0, running 0, pending 0', so)
+        # resume: nothing to run; the same folder without --resume, or with another grid: refused
+        rc, so, se = doe('run', '--out', out, '--resume', *grid)
+        self.assertEqual(rc, 0, se)
+        self.assertIn('3 cases: 3 done, 0 to run', so)
+        rc, _, se = doe('run', '--out', out, *grid)
+        self.assertEqual(rc, 2)
+        self.assertIn('holds a DOE already', se)
+        rc, _, se = doe('run', '--out', out, '--resume', '--grades', '0,1,3', *grid[2:])
+        self.assertEqual(rc, 2)
+        self.assertIn('grades', se)
+
+        # a runner that cannot start: every case fails, is reported with its error, and the exit
+        # status is 1; --resume alone keeps them failed, --retry-failed runs them
+        out2 = os.path.join(self.tmp, 'failing')
+        rc, so, se = doe('run', '--out', out2, *grid, env={'DM_RUN_SCENE': '/nonexistent/dm_run_scene'})
+        self.assertEqual(rc, 1, so + se)
+        self.assertIn('failed 3', so)
+        with open(os.path.join(out2, 'runs', 'g0_ci300.log')) as fh:
+            self.assertIn('cannot start /nonexistent/dm_run_scene', fh.read())
+        rc, so, se = doe('run', '--out', out2, '--resume', *grid)
+        self.assertEqual(rc, 1)
+        self.assertIn('failed before: g0_ci300', so)
+        self.assertIn('0 to run', so)
+        rc, so, se = doe('run', '--out', out2, '--resume', '--retry-failed', *grid)
+        self.assertEqual(rc, 0, so + se)
+        t2 = load(os.path.join(out2, 'doe_table.yaml'))
+        self.assertEqual((t2['simulated'], t2['implied'], t2['failed']), (2, 1, 0))
+
+    def test_bad_input_is_refused(self):
+        for args, what in ((['--jobs', '0'], '--jobs'), (['--duration', '90'], '--duration'),
+                           (['--cone-indices', '10,300', '--grades', '0,5'], 'cone index 10')):
+            rc, _, se = doe('run', '--out', os.path.join(self.tmp, 'bad'), '--dry-run', *args)
+            self.assertEqual(rc, 2, args)
+            self.assertIn(what, se)
+        rc, _, se = doe('status', '--out', os.path.join(self.tmp, 'nothing_here'))
+        self.assertEqual(rc, 2)
+        self.assertIn('no DOE here', se)
+
+
+if __name__ == '__main__':
+    unittest.main()
