@@ -15,6 +15,8 @@ DM_ROS_PACKAGES=(catkin ros-core-dev libroscpp-dev libnodeletlib-dev librosbag-d
   python3-rosbag python3-roslaunch python3-rostest python3-catkin-pkg python3-std-msgs python3-geometry-msgs python3-nodelet python3-matplotlib python3-numpy python3-yaml python3-tqdm)
 # the maps of the design of experiments (GDAL's tools and python bindings)
 DM_MAP_PACKAGES=(gdal-bin python3-gdal)
+# the Slurm backend of the design of experiments and its single-node test cluster
+DM_SLURM_PACKAGES=(slurmctld slurmd slurm-client munge)
 # only for the checks of the test command (package lint, rviz screenshot under Xvfb)
 DM_CHECK_PACKAGES=(catkin-lint rviz xvfb imagemagick)
 # only for the dem_step benchmark (the side-by-side LAMMPS run)

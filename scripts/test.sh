@@ -8,7 +8,7 @@
 #     (test/ros/test_single_wheel.py) and the vehicle on the DEM soil patch (test/ros/test_soil_slope.py),
 #  4. catkin_lint on the package (must report nothing).
 source "$(dirname "$0")/lib.sh"
-ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_MAP_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
+ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_MAP_PACKAGES[@]}" "${DM_SLURM_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
 build_core
 say "test: core suite (ctest, no ROS master)"
 (cd "$DM_BUILD/core" && ctest --output-on-failure --timeout 1200 -j2)

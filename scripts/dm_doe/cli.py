@@ -1,7 +1,7 @@
 """`doe`: the design of experiments over grade x cone index, from a raster to a map (docs/doe.md).
 
     doe plan  --elevation DEM.tif [--ci CI.tif | --ci-seed N] --level tiny
-    doe run   --out DIR [--grades ... --cone-indices ...] --level tiny --jobs 2 [--resume] [--dry-run]
+    doe run   --out DIR [--grades ... --cone-indices ...] --level tiny --jobs 2 [--backend slurm] [--resume] [--dry-run]
     doe status --out DIR
     doe nrmm  --out DIR [--grades ... --cone-indices ...]
     doe map   --table TABLE.yaml --elevation DEM.tif [--ci CI.tif | --ci-seed N] --out DIR [--compare OTHER.yaml]
@@ -23,7 +23,7 @@ from dm_sweep.args import floats, git_commit
 
 import dm_sweep
 
-from . import maps, nrmm, plan, raster, runner
+from . import maps, nrmm, plan, raster, runner, slurm
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -380,7 +380,24 @@ def cmd_run(a):
         len(doc['cases']), len(doc['cases']) - len(todo) - (0 if a.retry_failed else len(failed)), len(todo), a.jobs,
         a.runner))
     interrupted = False
-    if todo:
+    if todo and a.backend == 'slurm':
+        indices = [c['index'] for c in todo]
+        job = slurm.submit(a.out, doc, indices, a.jobs, a.partition, a.timeout)
+        print('doe: submitted job array %s: %d tasks, at most %d at once (states: doe status --out %s)' % (
+            job, len(indices), a.jobs, a.out), flush=True)
+        if a.no_wait:
+            return 0
+        try:
+            tasks, source = slurm.wait(a.out, doc, job, a.jobs)
+            lost = slurm.record_lost_tasks(a.out, doc, indices, tasks)
+            counts = {}
+            for v in tasks.values():
+                counts[v] = counts.get(v, 0) + 1
+            print('doe: job %s: %s (from %s)%s' % (job, ', '.join('%d %s' % (n, k) for k, n in sorted(counts.items())),
+                                                   source, '; %d tasks ended without a result' % len(lost) if lost else ''))
+        except KeyboardInterrupt:
+            interrupted = True
+    elif todo:
         by_index = {c['index']: c for c in doc['cases']}
         cases = dm_sweep.cases([{'index': c['index']} for c in todo], name=lambda p: by_index[p['index']]['name'])
 
@@ -421,6 +438,17 @@ def cmd_status(a):
     doc = runner.load_plan(a.out)
     states = runner.scan(a.out, doc)
     print(runner.status_text(a.out, doc, states, a.jobs))
+    for job in slurm.recorded_jobs(a.out):
+        try:
+            tasks, source = slurm.task_states(job)
+        except slurm.SlurmError as e:
+            print('  slurm job %s: %s' % (job, e))
+            continue
+        counts = {}
+        for v in tasks.values():
+            counts[v] = counts.get(v, 0) + 1
+        print('  slurm job %s: %s (from %s)' % (job, ', '.join('%d %s' % (n, k) for k, n in sorted(counts.items()))
+                                                 or 'no task known (finished long ago?)', source))
     if a.table:
         path, _ = runner.write_doe_table(a.out, doc, runner.table_rows(a.out, doc, states))
         print('table: %s' % path)
@@ -463,10 +491,10 @@ def parser():
     p.add_argument('--level', default='tiny', help='soil fidelity level of the runs (default tiny)')
     p.set_defaults(func=cmd_plan)
 
-    p = sub.add_parser('run', help='runs the DOE\'s cases on a local pool (resume, pruning, table and plots)',
+    p = sub.add_parser('run', help='runs the DOE\'s cases on a local pool or as a Slurm job array (resume, pruning, table, plots)',
                        description='Runs every case of the design (the plan as doe plan prints it) through the '
                        'same launch files and nodelets a user runs (soil_slope.launch; road_slope.launch for CI 300), '
-                       '--jobs at a time, in the plan\'s order; a case whose outcome the finished ones fix is '
+                       '--jobs at a time, in the plan\'s order, on a local pool or as one Slurm job array; a case whose outcome the finished ones fix is '
                        'recorded as implied, not run. Writes OUT/doe.yaml, OUT/runs/ (a result, log and bag per '
                        'case), OUT/doe_table.csv/.yaml and the plots. --resume keeps the finished cases.')
     grid_args(p)
@@ -478,14 +506,19 @@ def parser():
     p.add_argument('--runner', choices=('roslaunch', 'core'), default='roslaunch',
                    help='roslaunch (default: the launch files, a bag per case) or core (build/core\'s dm_run_scene: '
                    'the same loop in one process, no bag)')
-    p.add_argument('--jobs', type=int, default=1, help='cases at a time (default 1)')
-    p.add_argument('--dem-threads', type=int, default=1, help='soil threads of each run (default 1)')
+    p.add_argument('--backend', choices=('local', 'slurm'), default='local',
+                   help='local: a process pool here (default); slurm: one job array (sbatch --array), a task per '
+                   'case, in --out (a folder every node sees)')
+    p.add_argument('--jobs', type=int, default=1, help='cases at a time: the pool\'s size, or the array\'s %%N (default 1)')
+    p.add_argument('--partition', help='slurm: the partition (default: the cluster\'s)')
+    p.add_argument('--no-wait', action='store_true', help='slurm: submit and return (doe status follows it)')
+    p.add_argument('--dem-threads', type=int, default=1, help='soil threads of each run (default 1; slurm: --cpus-per-task)')
     p.add_argument('--duration', type=float, help='longest driving time [s] (default: the scenes\' 40 s)')
     p.add_argument('--no-prune', action='store_true', help='run every case (no implied cases)')
     p.add_argument('--resume', action='store_true', help='go on with the DOE in --out: finished cases are kept')
     p.add_argument('--retry-failed', action='store_true', help='with --resume: run the failed cases again')
     p.add_argument('--dry-run', action='store_true', help='print the plan and its estimated cost, run nothing')
-    p.add_argument('--timeout', type=float, help='longest a case may take [s]')
+    p.add_argument('--timeout', type=float, help='longest a case may take [s] (slurm: the tasks\' --time)')
     p.add_argument('--port', type=int, default=11611, help='first ROS master port of the pool (default 11611)')
     p.add_argument('--progress', choices=('auto', 'tqdm', 'plain'), default='auto',
                    help='a progress bar (tqdm, in s of estimated cost) on a terminal; plain: lines only')

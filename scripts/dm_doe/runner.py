@@ -246,6 +246,15 @@ def case_command(doc, case, out, port, dm_run_scene=None):
     return argv + ['--out', result, '--history', result[:-len('.result.yaml')] + '.history.csv']
 
 
+def free_port(port):
+    """`port`, or the first free one above it (2 apart, as the pool's)."""
+    from dm_sweep.pool import port_free
+    for k in range(100):
+        if port_free(port + 2 * k):
+            return port + 2 * k
+    return port
+
+
 def port_from_env(default=11611):
     uri = os.environ.get('ROS_MASTER_URI', '')
     try:
@@ -286,7 +295,10 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
                 os.remove(p)
         write_yaml(marker_path(out, case), {'host': socket.gethostname(), 'pid': os.getpid(), 'start': utc_now(),
                                             'slurm_job': os.environ.get('SLURM_JOB_ID')})
-    argv = case_command(doc, case, out, port or port_from_env(), dm_run_scene)
+    if port is None:
+        port = port_from_env()
+    port = free_port(port)
+    argv = case_command(doc, case, out, port, dm_run_scene)
     log = os.path.join(runs_dir(out), case['name'] + '.log')
     t0 = time.time()
     try:
@@ -294,7 +306,8 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
             fh.write('$ %s\n' % ' '.join(argv))
             fh.flush()
             try:
-                rc = subprocess.call(argv, stdout=fh, stderr=subprocess.STDOUT)
+                env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % port)
+                rc = subprocess.call(argv, stdout=fh, stderr=subprocess.STDOUT, env=env)
             except OSError as e:
                 fh.write('cannot start %s: %s\n' % (argv[0], e))
                 rc = 127

@@ -17,7 +17,8 @@ import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import cli, plan, runner  # noqa: E402
+from dm_doe import cli, plan, runner, slurm  # noqa: E402
+from dm_doe.local_cluster import LocalCluster  # noqa: E402
 
 DOE = os.path.join(ROOT, 'scripts', 'doe')
 DM_RUN_SCENE = os.environ.get('DM_RUN_SCENE', os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene'))
@@ -163,6 +164,53 @@ class RoadDoe(unittest.TestCase):
         rc, _, se = doe('status', '--out', os.path.join(self.tmp, 'nothing_here'))
         self.assertEqual(rc, 2)
         self.assertIn('no DOE here', se)
+
+
+def have_slurm():
+    return all(os.path.exists(p) for p in ('/usr/sbin/slurmctld', '/usr/sbin/slurmd', '/usr/sbin/munged', '/usr/bin/sbatch'))
+
+
+@unittest.skipUnless(os.access(DM_RUN_SCENE, os.X_OK), 'no dm_run_scene at %s (build the core first)' % DM_RUN_SCENE)
+@unittest.skipUnless(have_slurm(), 'no Slurm (scripts/lib.sh DM_SLURM_PACKAGES)')
+class SlurmDoe(unittest.TestCase):
+    """The same road DOE as a job array on a real single-node cluster (dm_doe.local_cluster: its own
+    munge key, slurm.conf and ports in a temporary directory): the table is the local pool's."""
+
+    def test_job_array_gives_the_local_pools_table(self):
+        tmp = tempfile.mkdtemp(prefix='dm_doe_slurm_')
+        try:
+            grid = ['--grades', '0,1,2', '--cone-indices', '300', '--runner', 'core', '--progress', 'plain']
+            local = os.path.join(tmp, 'local')
+            rc, so, se = doe('run', '--out', local, *grid)
+            self.assertEqual(rc, 0, so + se)
+            with LocalCluster() as c:
+                out = os.path.join(tmp, 'slurm')
+                # one task at a time: the array runs in the plan's order, as the pool with --jobs 1
+                rc, so, se = doe('run', '--out', out, '--backend', 'slurm', '--jobs', '1', *grid, env=c.env)
+                self.assertEqual(rc, 0, so + se)
+                self.assertIn('submitted job array', so)
+                self.assertIn('3 COMPLETED (from sacct -c (job completion log) and squeue)', so)
+                jobs = load(os.path.join(out, 'slurm', 'jobs.yaml'))['jobs']
+                self.assertEqual((len(jobs), jobs[0]['tasks']), (1, '0-2'))
+                # every task wrote its output; the cases their results
+                for k in range(3):
+                    self.assertTrue(os.path.exists(os.path.join(out, 'slurm', '%s_%d.out' % (jobs[0]['job'], k))))
+                rc, so, _ = doe('status', '--out', out, env=c.env)
+                self.assertIn('simulated 2, implied 1', so)
+                self.assertIn('slurm job %s: 3 COMPLETED' % jobs[0]['job'], so)
+                # a case whose task dies without a result: failed, with the task's state
+                doc = runner.load_plan(out)
+                lost = slurm.record_lost_tasks(out, doc, [0], {0: 'CANCELLED'})
+                self.assertEqual(lost, [])  # case 0 has its result: nothing lost
+            a, b = load(os.path.join(local, 'doe_table.yaml')), load(os.path.join(out, 'doe_table.yaml'))
+            self.assertEqual(a['speed'], b['speed'])  # bit for bit: the runs are deterministic
+            self.assertEqual([r['source'] for r in a['cases_table']], [r['source'] for r in b['cases_table']])
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+    def test_array_ranges(self):
+        self.assertEqual(slurm.ranges([0, 1, 2, 3, 5, 7, 8]), '0-3,5,7-8')
+        self.assertEqual(slurm.ranges([4]), '4')
 
 
 if __name__ == '__main__':
