@@ -5,7 +5,8 @@
 #     file and the rostest of the lock-step exchange (test/ros/road_scene.test),
 #  3. the end-to-end road runs through roslaunch (test/ros/test_road_runs.py), the cone index
 #     calibration sweep on tiny cases (test/ros/test_cone_sweep.py), the single-wheel rig
-#     (test/ros/test_single_wheel.py) and the vehicle on the DEM soil patch (test/ros/test_soil_slope.py),
+#     (test/ros/test_single_wheel.py), the vehicle on the DEM soil patch (test/ros/test_soil_slope.py) and
+#     the speed-made-good map published as an OccupancyGrid (test/ros/test_map_publisher.py),
 #  4. catkin_lint on the package (must report nothing).
 source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_MAP_PACKAGES[@]}" "${DM_SLURM_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
@@ -31,6 +32,8 @@ say "test: the single-wheel rig through roslaunch (tiny run: bag, result message
 python3 "$DM_ROOT/test/ros/test_single_wheel.py"
 say "test: the vehicle on the DEM soil patch through roslaunch (tiny: result and soil figures as the core runner's, bag, 1 vs 2 soil threads; a bad cone index)"
 DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 "$DM_ROOT/test/ros/test_soil_slope.py"
+say "test: the speed-made-good map on ROS (mobility_map.launch: nav_msgs/OccupancyGrid as map_server reads the file)"
+python3 "$DM_ROOT/test/ros/test_map_publisher.py"
 say "test: catkin_lint"
 lint=$(cd "$DM_WS/src" && catkin_lint dem_mobility 2>&1 | grep -v rosdep)
 echo "$lint"
