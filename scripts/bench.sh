@@ -9,14 +9,17 @@
 #   ./scripts/bench.sh soil_scene       the vehicle on the moving soil patch per level: wall s per simulated s,
 #                                       and the coupled step's rate against the bare soil patch
 #                                       (levels: DM_SOIL_LEVELS, default tiny,coarse; paper takes hours to prepare)
+#   ./scripts/bench.sh doe_map          the time to map a 22 km x 22 km region (1101 x 1101 cells) from a finished table
 source "$(dirname "$0")/lib.sh"
 want="${1:-all}"
-case "$want" in all|vehicle_step|cosim_exchange|road_scene|dem_step|wheel_soil|soil_scene) ;; *)
-  echo "unknown benchmark '$want' (have: vehicle_step cosim_exchange road_scene dem_step wheel_soil soil_scene)" >&2; exit 2 ;;
+case "$want" in all|vehicle_step|cosim_exchange|road_scene|dem_step|wheel_soil|soil_scene|doe_map) ;; *)
+  echo "unknown benchmark '$want' (have: vehicle_step cosim_exchange road_scene dem_step wheel_soil soil_scene doe_map)" >&2; exit 2 ;;
 esac
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}"
 build_core >/dev/null
-if [ "$want" != vehicle_step ] && [ "$want" != dem_step ] && [ "$want" != wheel_soil ] && [ "$want" != soil_scene ]; then build_catkin >/dev/null; ros_env; fi
+if [ "$want" = doe_map ]; then ensure_packages "${DM_MAP_PACKAGES[@]}"; fi
+if [ "$want" != vehicle_step ] && [ "$want" != dem_step ] && [ "$want" != wheel_soil ] && [ "$want" != soil_scene ] &&
+   [ "$want" != doe_map ]; then build_catkin >/dev/null; ros_env; fi
 echo "# $(date -u +%Y-%m-%dT%H:%MZ) $(uname -m) $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
@@ -96,4 +99,8 @@ if [ "$want" = all ] || [ "$want" = soil_scene ]; then
   # preparation, 0.3 s of settling and 0.2 s of driving; the soil at the scene's threads (2)
   "$DM_BUILD/core/bench/soil_scene_bench" "$DM_ROOT/config/scenes/soil_slope.yaml" "${DM_SOIL_LEVELS:-tiny,coarse}" \
     "${DM_SOIL_WINDOW:-0.05}" grade_deg=12 settle_time=0.3 terrain_overrides.cone_index=100
+fi
+
+if [ "$want" = all ] || [ "$want" = doe_map ]; then
+  python3 "$DM_ROOT/scripts/tools/bench_doe_map.py" "$tmp/doe_map"
 fi

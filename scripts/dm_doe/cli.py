@@ -371,7 +371,7 @@ def cmd_run(a):
             raise UsageError('case %s is running (runs/%s.running): another doe run on %s?' % (
                 doc['cases'][k]['name'], doc['cases'][k]['name'], a.out))
     failed = [c for c in doc['cases'] if states[c['index']][0] == 'failed']
-    todo = [c for c in doc['cases'] if states[c['index']][0] == 'pending' or (a.retry_failed and c in failed)]
+    todo = [c for c in doc['cases'] if states[c['index']][0] in ('pending', 'interrupted') or (a.retry_failed and c in failed)]
     for c in failed:
         if not a.retry_failed:
             print('failed before: %s: %s (--retry-failed runs it again)' % (

@@ -171,21 +171,28 @@ def marker_alive(path):
     if doc.get('host') != socket.gethostname():
         return True
     try:
-        os.kill(int(doc.get('pid', -1)), 0)
-        return True
+        pid = int(doc.get('pid', -1))
+        os.kill(pid, 0)
     except (OSError, ValueError, TypeError):
         return False
+    try:  # a killed worker not yet reaped (a zombie) is gone too
+        with open('/proc/%d/stat' % pid) as fh:
+            return fh.read().rsplit(')', 1)[1].split()[0] != 'Z'
+    except (OSError, IndexError):
+        return True
 
 
 def scan(out, doc):
-    """{index: (state, result)}: state 'simulated', 'implied', 'failed', 'running' or 'pending'."""
+    """{index: (state, result)}: state 'simulated', 'implied', 'failed' (its run ended without a good
+    result), 'running', 'interrupted' (its worker was killed mid-run: a `running` marker whose
+    process is gone) or 'pending'."""
     states = {}
     for case in doc['cases']:
         r = read_result(result_path(out, case))
         if r is not None and verdict(case, r) is None:
             states[case['index']] = ('implied' if r.get('status') == IMPLIED else 'simulated', r)
-        elif os.path.exists(marker_path(out, case)) and marker_alive(marker_path(out, case)):
-            states[case['index']] = ('running', r)
+        elif os.path.exists(marker_path(out, case)):
+            states[case['index']] = ('running' if marker_alive(marker_path(out, case)) else 'interrupted', r)
         elif r is not None or os.path.exists(os.path.join(runs_dir(out), case['name'] + '.log')):
             states[case['index']] = ('failed', r)
         else:
@@ -278,6 +285,8 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
         if state in ('simulated', 'implied'):
             print('%s: done before (%s)' % (case['name'], state), file=stream)
             return 0
+        if state == 'running':
+            raise RunnerError('case %s is running already (%s)' % (case['name'], marker_path(out, case)))
         x = decide(case, doc, states)
         if x is not None:
             status, speed, by = x
@@ -381,7 +390,7 @@ def write_doe_table(out, doc, rows):
                'run_commits': commits, 'calibration_tables': tables, 'made': utc_now(),
                'cases': len(rows), 'simulated': n_sim, 'implied': n_imp, 'runs_saved': n_imp,
                'failed': sum(1 for r in rows if r['state'] == 'failed'),
-               'not_run': sum(1 for r in rows if r['state'] in ('pending', 'running')),
+               'not_run': sum(1 for r in rows if r['state'] in ('pending', 'running', 'interrupted')),
                'grades': grades, 'cone_indices': cis, 'speed': speed, 'cases_table': rows}
     write_yaml(stem + '.yaml', summary)
     return stem + '.yaml', summary
@@ -392,7 +401,7 @@ def write_doe_table(out, doc, rows):
 def eta_seconds(doc, states, parallel, elapsed_ratio=None):
     """Estimated wall seconds left: the pending cases' estimated cost over `parallel` runs at once,
     scaled by how the finished runs compared with their estimates (elapsed_ratio)."""
-    left = sum(c['estimated_cost'] for c in doc['cases'] if states[c['index']][0] in ('pending', 'running'))
+    left = sum(c['estimated_cost'] for c in doc['cases'] if states[c['index']][0] in ('pending', 'running', 'interrupted'))
     return left / max(1, parallel) * (elapsed_ratio or 1.0)
 
 
@@ -419,9 +428,11 @@ def status_text(out, doc, states, parallel=1):
     ratio = measured_ratio(out, doc, states)
     lines = ['doe %s: %d cases (%d grades x %d cone indices), level %s, runner %s' % (
         out, n, len(doc['grades']), len(doc['cone_indices']), doc['level'], doc['runner'])]
-    lines.append('  simulated %d, implied %d (runs saved), failed %d, running %d, pending %d' % tuple(
-        counts.get(k, 0) for k in ('simulated', 'implied', 'failed', 'running', 'pending')))
-    left = counts.get('pending', 0) + counts.get('running', 0)
+    lines.append('  simulated %d, implied %d (runs saved), failed %d, running %d, pending %d%s' % (tuple(
+        counts.get(k, 0) for k in ('simulated', 'implied', 'failed', 'running', 'pending')) + (
+        ', interrupted %d (killed mid-run: --resume runs them again)' % counts['interrupted'] if 'interrupted' in counts
+        else '',)))
+    left = counts.get('pending', 0) + counts.get('running', 0) + counts.get('interrupted', 0)
     if left:
         lines.append('  ETA ~%.0f min for the %d cases left at most (%d at a time; estimates %s)' % (
             eta_seconds(doc, states, parallel, ratio) / 60.0, left, parallel,

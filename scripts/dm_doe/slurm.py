@@ -148,7 +148,7 @@ def wait(out, doc, job, parallel, poll=2.0, stream=None, timeout=None):
                     c = doc['cases'][k]
                     what = ('implied %s by %s' % (r['implied_status'], r['implied_by']) if s == 'implied' else
                             '%s %.3f m/s' % (r.get('status'), float(r.get('speed_made_good') or 0.0)))
-                    left = sum(1 for x, _ in states.values() if x in ('pending', 'running'))
+                    left = sum(1 for x, _ in states.values() if x in ('pending', 'running', 'interrupted'))
                     print('[%6.0f s] done   %-14s %s  [%d left]  ETA ~%.0f min' % (
                         time.time() - t0, c['name'], what, left,
                         runner.eta_seconds(doc, states, parallel, runner.measured_ratio(out, doc, states)) / 60.0),
@@ -176,11 +176,13 @@ def record_lost_tasks(out, doc, indices, states):
     now = runner.scan(out, doc)
     for k in indices:
         s = states.get(k)
-        if s in DONE_STATES and now[k][0] in ('pending', 'running'):
+        if s in DONE_STATES and now[k][0] in ('pending', 'running', 'interrupted'):
             c = doc['cases'][k]
             runner.write_yaml(runner.result_path(out, c), {
                 'kind': 'doe_task', 'status': 'error', 'grade_deg': c['grade_deg'], 'cone_index_psi': c['cone_index'],
                 'error': 'the Slurm task ended %s without the case\'s result; see %s' % (
                     s, os.path.join(out, 'slurm', '*_%d.out' % k))})
+            if os.path.exists(runner.marker_path(out, c)):
+                os.remove(runner.marker_path(out, c))  # its worker is gone with the task
             lost.append(k)
     return lost

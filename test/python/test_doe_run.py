@@ -155,6 +155,41 @@ class RoadDoe(unittest.TestCase):
         t2 = load(os.path.join(out2, 'doe_table.yaml'))
         self.assertEqual((t2['simulated'], t2['implied'], t2['failed']), (2, 1, 0))
 
+    def test_a_killed_doe_loses_no_finished_case_and_resume_runs_what_is_missing(self):
+        import signal
+        import time
+        out = os.path.join(self.tmp, 'killed')
+        grid = ['--grades', '0,1,2', '--cone-indices', '300', '--runner', 'core', '--progress', 'plain', '--no-prune']
+        env = dict(os.environ, DM_RUN_SCENE=DM_RUN_SCENE)
+        p = subprocess.Popen([sys.executable, DOE, 'run', '--out', out] + grid, stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL, env=env, start_new_session=True)
+        first, marker = os.path.join(out, 'runs', 'g0_ci300.result.yaml'), os.path.join(out, 'runs', 'g2_ci300.running')
+        t0 = time.time()
+        while not (os.path.exists(first) and os.path.exists(marker)) and time.time() - t0 < 120:
+            time.sleep(0.2)
+        self.assertTrue(os.path.exists(marker), 'the second case never started')
+        with open(first) as fh:
+            kept = fh.read()
+        # the runner and the case's worker killed mid-run (SIGKILL: no clean-up)
+        worker = load(marker)['pid']
+        os.killpg(p.pid, signal.SIGKILL)
+        os.killpg(os.getpgid(worker), signal.SIGKILL)
+        p.wait()
+        for _ in range(50):  # (the killed worker is gone within moments)
+            rc, so, _ = doe('status', '--out', out)
+            if 'interrupted' in so:
+                break
+            time.sleep(0.1)
+        self.assertIn('simulated 1,', so)
+        self.assertIn('interrupted 1 (killed mid-run', so)
+        rc, so, se = doe('run', '--out', out, '--resume', *grid)
+        self.assertEqual(rc, 0, so + se)
+        self.assertIn('3 cases: 1 done, 2 to run', so)
+        with open(first) as fh:
+            self.assertEqual(fh.read(), kept)  # the finished case untouched
+        t = load(os.path.join(out, 'doe_table.yaml'))
+        self.assertEqual((t['simulated'], t['implied'], t['failed'], t['not_run']), (3, 0, 0, 0))
+
     def test_bad_input_is_refused(self):
         for args, what in ((['--jobs', '0'], '--jobs'), (['--duration', '90'], '--duration'),
                            (['--cone-indices', '10,300', '--grades', '0,5'], 'cone index 10')):
