@@ -365,6 +365,12 @@ def cmd_run(a):
     os.makedirs(runner.runs_dir(a.out), exist_ok=True)
     if not os.path.exists(path):
         runner.write_yaml(path, doc)
+    active, lines = slurm.reconcile(a.out, doc)
+    for line in lines:
+        print(line)
+    if active:
+        raise UsageError('%s: %d tasks of its Slurm jobs are still pending or running: wait (doe status), or scancel '
+                         'them, before --resume' % (a.out, active))
     states = runner.scan(a.out, doc)
     for k, (s, r) in states.items():
         if s == 'running':
@@ -388,7 +394,7 @@ def cmd_run(a):
         if a.no_wait:
             return 0
         try:
-            tasks, source = slurm.wait(a.out, doc, job, a.jobs)
+            tasks, source = slurm.wait(a.out, doc, job, indices, a.jobs)
             lost = slurm.record_lost_tasks(a.out, doc, indices, tasks)
             counts = {}
             for v in tasks.values():
@@ -415,11 +421,14 @@ def cmd_run(a):
             check=lambda case, r: runner.verdict(by_index[case['index']], r), accept_status=(runner.IMPLIED,),
             result_of=lambda case: runner.result_path(a.out, by_index[case['index']]),
             weight=lambda case: by_index[case['index']]['estimated_cost'], describe=describe,
-            progress=a.progress, status_every=None)
+            progress=a.progress, status_every=None, clear_result=False)
         try:
             sweep.run()
         except KeyboardInterrupt:
             interrupted = True
+        for o in sweep.outcomes:
+            if o.timed_out:
+                runner.record_failure(a.out, doc, by_index[o.case['index']], o.error)
     states = runner.scan(a.out, doc)
     rows = runner.table_rows(a.out, doc, states)
     table, summary = runner.write_doe_table(a.out, doc, rows)
@@ -436,19 +445,11 @@ def cmd_run(a):
 
 def cmd_status(a):
     doc = runner.load_plan(a.out)
+    _, lines = slurm.reconcile(a.out, doc)
     states = runner.scan(a.out, doc)
     print(runner.status_text(a.out, doc, states, a.jobs))
-    for job in slurm.recorded_jobs(a.out):
-        try:
-            tasks, source = slurm.task_states(job)
-        except slurm.SlurmError as e:
-            print('  slurm job %s: %s' % (job, e))
-            continue
-        counts = {}
-        for v in tasks.values():
-            counts[v] = counts.get(v, 0) + 1
-        print('  slurm job %s: %s (from %s)' % (job, ', '.join('%d %s' % (n, k) for k, n in sorted(counts.items()))
-                                                 or 'no task known (finished long ago?)', source))
+    for line in lines:
+        print('  ' + line)
     if a.table:
         path, _ = runner.write_doe_table(a.out, doc, runner.table_rows(a.out, doc, states))
         print('table: %s' % path)

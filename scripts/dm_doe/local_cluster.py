@@ -107,11 +107,15 @@ class LocalCluster:
         while time.time() - t0 < self.timeout:
             for p in self.procs:
                 if p.poll() is not None:
-                    raise ClusterError('%s exited (%d) at start; see %s/log' % (p.args[0], p.returncode, self.root))
+                    err = ClusterError('%s exited (%d) at start; see %s/log' % (p.args[0], p.returncode, self.root))
+                    self.own_root = False  # keep the logs
+                    self.stop()
+                    raise err
             q = subprocess.run(['sinfo', '-h', '-N', '-o', '%T'], capture_output=True, text=True, env=self.env)
             if q.returncode == 0 and q.stdout.strip() in ('idle', 'mixed', 'allocated'):
                 return self
             time.sleep(0.3)
+        self.own_root = False  # keep the logs
         self.stop()
         raise ClusterError('the node was not idle after %.0f s; see %s/log' % (self.timeout, self.root))
 

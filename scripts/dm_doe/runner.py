@@ -20,6 +20,7 @@ import contextlib
 import datetime
 import fcntl
 import os
+import signal
 import socket
 import subprocess
 import sys
@@ -163,8 +164,8 @@ def verdict(case, result):
 
 
 def marker_alive(path):
-    """A `running` marker's worker: alive (this host and its pid exists, or another host's: taken as
-    alive), or stale."""
+    """A `running` marker's worker: alive (this host and its pid exists; another host's: taken as
+    alive, a Slurm task's until `reconcile` finds its task ended), or stale."""
     doc = read_result(path)
     if doc is None:
         return False
@@ -189,8 +190,12 @@ def scan(out, doc):
     states = {}
     for case in doc['cases']:
         r = read_result(result_path(out, case))
-        if r is not None and verdict(case, r) is None:
+        prov = read_result(provenance_path(out, case)) if r is not None and r.get('status') != IMPLIED else None
+        exited = prov.get('exit_status') if prov else 0
+        if r is not None and verdict(case, r) is None and exited == 0:
             states[case['index']] = ('implied' if r.get('status') == IMPLIED else 'simulated', r)
+        elif r is not None and r.get('status') == 'interrupted' and r.get('kind') == 'doe_case':
+            states[case['index']] = ('interrupted', r)
         elif os.path.exists(marker_path(out, case)):
             states[case['index']] = ('running' if marker_alive(marker_path(out, case)) else 'interrupted', r)
         elif r is not None or os.path.exists(os.path.join(runs_dir(out), case['name'] + '.log')):
@@ -304,23 +309,43 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
                 os.remove(p)
         write_yaml(marker_path(out, case), {'host': socket.gethostname(), 'pid': os.getpid(), 'start': utc_now(),
                                             'slurm_job': os.environ.get('SLURM_JOB_ID')})
-    if port is None:
-        port = port_from_env()
-    port = free_port(port)
+    if port is None:  # (a port given is the pool's slot's or the array task's own: taken as it is)
+        port = free_port(port_from_env())
     argv = case_command(doc, case, out, port, dm_run_scene)
     log = os.path.join(runs_dir(out), case['name'] + '.log')
     t0 = time.time()
+    child = []
+
+    def stopped(signum, frame):
+        # SIGTERM (the pool's timeout or Ctrl-C, Slurm's time limit or scancel): the run stops, the
+        # case is recorded interrupted (resume runs it again; a timeout is made a failure by
+        # whoever set it), the marker goes
+        for c in child:
+            with contextlib.suppress(OSError):
+                c.terminate()
+            with contextlib.suppress(Exception):
+                c.wait(20)
+        write_yaml(result_path(out, case), {
+            'kind': 'doe_case', 'status': 'interrupted', 'grade_deg': case['grade_deg'],
+            'cone_index_psi': case['cone_index'], 'error': 'the case was stopped (signal %d) after %.0f s; see %s'
+            % (signum, time.time() - t0, log)})
+        with contextlib.suppress(OSError):
+            os.remove(marker_path(out, case))
+        os._exit(128 + signum)
+    signal.signal(signal.SIGTERM, stopped)
     try:
         with open(log, 'w') as fh:
             fh.write('$ %s\n' % ' '.join(argv))
             fh.flush()
             try:
                 env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % port)
-                rc = subprocess.call(argv, stdout=fh, stderr=subprocess.STDOUT, env=env)
+                child.append(subprocess.Popen(argv, stdout=fh, stderr=subprocess.STDOUT, env=env))
+                rc = child[0].wait()
             except OSError as e:
                 fh.write('cannot start %s: %s\n' % (argv[0], e))
                 rc = 127
     finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
         with contextlib.suppress(OSError):
             os.remove(marker_path(out, case))
     write_yaml(provenance_path(out, case), {'commit': git_commit(ROOT), 'host': socket.gethostname(),
@@ -336,6 +361,20 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
     print('%s: %s, %.3f m/s (%.0f s)' % (case['name'], r.get('status'), float(r.get('speed_made_good') or 0.0),
                                          time.time() - t0), file=stream)
     return 0
+
+
+def record_failure(out, doc, case, error, kind='doe_case', status='error'):
+    """Records that a case failed (a timeout, a lost Slurm task), under the lock, unless a good
+    result is there by now (it is never replaced). True if recorded."""
+    with locked(out):
+        states = scan(out, doc)
+        if states[case['index']][0] in ('simulated', 'implied'):
+            return False
+        write_yaml(result_path(out, case), {'kind': kind, 'status': status, 'grade_deg': case['grade_deg'],
+                                            'cone_index_psi': case['cone_index'], 'error': error})
+        with contextlib.suppress(OSError):
+            os.remove(marker_path(out, case))
+    return True
 
 
 # -- the table ------------------------------------------------------------------------------------
@@ -430,7 +469,7 @@ def status_text(out, doc, states, parallel=1):
         out, n, len(doc['grades']), len(doc['cone_indices']), doc['level'], doc['runner'])]
     lines.append('  simulated %d, implied %d (runs saved), failed %d, running %d, pending %d%s' % (tuple(
         counts.get(k, 0) for k in ('simulated', 'implied', 'failed', 'running', 'pending')) + (
-        ', interrupted %d (killed mid-run: --resume runs them again)' % counts['interrupted'] if 'interrupted' in counts
+        ', interrupted %d (stopped mid-run: --resume runs them again)' % counts['interrupted'] if 'interrupted' in counts
         else '',)))
     left = counts.get('pending', 0) + counts.get('running', 0) + counts.get('interrupted', 0)
     if left:

@@ -132,9 +132,10 @@ def task_states(job):
     return states, 'squeue'
 
 
-def wait(out, doc, job, parallel, poll=2.0, stream=None, timeout=None):
-    """Waits for the job array, printing a line per case finished (from the cases' files) with the
-    ETA; returns the final task states. Ctrl-C cancels the job (scancel) and raises."""
+def wait(out, doc, job, indices, parallel, poll=2.0, stream=None, timeout=None):
+    """Waits until Slurm reports every task of `indices` ended, printing a line per case finished
+    (from the cases' files) with the ETA; returns the final task states. Ctrl-C cancels the job
+    (scancel) and raises."""
     stream = stream or sys.stdout
     t0 = time.time()
     seen = {k for k, (s, _) in runner.scan(out, doc).items() if s in ('simulated', 'implied')}
@@ -153,13 +154,9 @@ def wait(out, doc, job, parallel, poll=2.0, stream=None, timeout=None):
                         time.time() - t0, c['name'], what, left,
                         runner.eta_seconds(doc, states, parallel, runner.measured_ratio(out, doc, states)) / 60.0),
                         file=stream, flush=True)
-            q = _squeue(job)
-            if q and all(v[0] in DONE_STATES for v in q.values()):
+            ts, _ = task_states(job)
+            if set(indices) <= set(ts) and all(ts[k] in DONE_STATES for k in indices):
                 break
-            if not q:  # the job left squeue (MinJobAge): ask sacct
-                ts, _ = task_states(job)
-                if all(v in DONE_STATES for v in ts.values()):
-                    break
             if timeout is not None and time.time() - t0 > timeout:
                 raise SlurmError('job %s: not finished after %.0f s' % (job, timeout))
     except KeyboardInterrupt:
@@ -170,19 +167,38 @@ def wait(out, doc, job, parallel, poll=2.0, stream=None, timeout=None):
 
 def record_lost_tasks(out, doc, indices, states):
     """A task that ended (in Slurm's view) without its case's result (killed, timed out, a worker
-    that could not start): its case is recorded as failed, with the task's state and output file,
-    so that status and --resume see it."""
+    that could not start): its case is recorded as failed with the task's state and output file
+    (under the lock; a result there by now is never replaced), so that status and --resume see
+    it. Returns the cases recorded."""
     lost = []
     now = runner.scan(out, doc)
     for k in indices:
         s = states.get(k)
         if s in DONE_STATES and now[k][0] in ('pending', 'running', 'interrupted'):
             c = doc['cases'][k]
-            runner.write_yaml(runner.result_path(out, c), {
-                'kind': 'doe_task', 'status': 'error', 'grade_deg': c['grade_deg'], 'cone_index_psi': c['cone_index'],
-                'error': 'the Slurm task ended %s without the case\'s result; see %s' % (
-                    s, os.path.join(out, 'slurm', '*_%d.out' % k))})
-            if os.path.exists(runner.marker_path(out, c)):
-                os.remove(runner.marker_path(out, c))  # its worker is gone with the task
-            lost.append(k)
+            if runner.record_failure(out, doc, c, 'the Slurm task ended %s without the case\'s result; see %s' % (
+                    s, os.path.join(out, 'slurm', '*_%d.out' % k)), kind='doe_task'):
+                lost.append(k)
     return lost
+
+
+def reconcile(out, doc):
+    """Before `doe status` and `doe run --resume`: the recorded jobs' tasks that ended without a
+    result are recorded as failed (a task killed by its time limit or scancel leaves its marker).
+    Returns (tasks still pending or running, lines to print)."""
+    active, lines = 0, []
+    for job in recorded_jobs(out):
+        try:
+            tasks, source = task_states(job)
+        except SlurmError as e:
+            lines.append('slurm job %s: %s' % (job, e))
+            continue
+        active += sum(1 for v in tasks.values() if v not in DONE_STATES)
+        lost = record_lost_tasks(out, doc, sorted(tasks), tasks)
+        counts = {}
+        for v in tasks.values():
+            counts[v] = counts.get(v, 0) + 1
+        lines.append('slurm job %s: %s (from %s)%s' % (
+            job, ', '.join('%d %s' % (n, k) for k, n in sorted(counts.items())) or 'no task known (finished long ago?)',
+            source, '; %d ended without a result: recorded failed' % len(lost) if lost else ''))
+    return active, lines

@@ -112,6 +112,8 @@ class Sweep:
     describe: callable outcome -> the text after a finished run's name (default 'ok' or
       'FAILED: <error>').
     result_of: callable case -> the path of its result file (default <runs_dir>/<name>.result.yaml).
+    clear_result: delete a run's result file before it starts (default; False where the command
+      itself decides, e.g. `doe case` under its lock).
     weight: callable case -> its estimated cost [s] (default 1 each): the progress bar counts in it
       and each finished run's line gives an ETA (the weight left, at the rate of the weight done so
       far in this sweep).
@@ -123,7 +125,7 @@ class Sweep:
     def __init__(self, cases, command, runs_dir, jobs=1, port=11411, timeout=None, check=None, outputs=None,
                  env=None, describe=None, progress='auto', poll=1.0, status_every=20.0,
                  progress_marker='progress:', kill_grace=30.0, stream=None, accept_status=(), result_of=None,
-                 weight=None):
+                 weight=None, clear_result=True):
         if jobs < 1:
             raise ValueError('jobs must be >= 1')
         self.accept_status = tuple(accept_status)
@@ -150,6 +152,7 @@ class Sweep:
         self.stream = stream
         self.t0 = None
         self.result_of = result_of
+        self.clear_result = clear_result
         self.weighted = weight is not None
         self.weight = weight or (lambda case: 1.0)
         self.outcomes = [Outcome(c, self.result_path(c), self.log_path(c)) for c in self.cases]
@@ -228,7 +231,7 @@ class Sweep:
         return slot, port
 
     def _launch(self, o):
-        for p in (list(self.outputs(o.case)) if self.outputs else []) + [o.result_file]:
+        for p in (list(self.outputs(o.case)) if self.outputs else []) + ([o.result_file] if self.clear_result else []):
             if os.path.exists(p):
                 os.remove(p)
         env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % o.port, PYTHONUNBUFFERED='1',

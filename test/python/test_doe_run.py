@@ -11,6 +11,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 import yaml
@@ -157,7 +158,6 @@ class RoadDoe(unittest.TestCase):
 
     def test_a_killed_doe_loses_no_finished_case_and_resume_runs_what_is_missing(self):
         import signal
-        import time
         out = os.path.join(self.tmp, 'killed')
         grid = ['--grades', '0,1,2', '--cone-indices', '300', '--runner', 'core', '--progress', 'plain', '--no-prune']
         env = dict(os.environ, DM_RUN_SCENE=DM_RUN_SCENE)
@@ -181,7 +181,7 @@ class RoadDoe(unittest.TestCase):
                 break
             time.sleep(0.1)
         self.assertIn('simulated 1,', so)
-        self.assertIn('interrupted 1 (killed mid-run', so)
+        self.assertIn('interrupted 1 (stopped mid-run', so)
         rc, so, se = doe('run', '--out', out, '--resume', *grid)
         self.assertEqual(rc, 0, so + se)
         self.assertIn('3 cases: 1 done, 2 to run', so)
@@ -189,6 +189,20 @@ class RoadDoe(unittest.TestCase):
             self.assertEqual(fh.read(), kept)  # the finished case untouched
         t = load(os.path.join(out, 'doe_table.yaml'))
         self.assertEqual((t['simulated'], t['implied'], t['failed'], t['not_run']), (3, 0, 0, 0))
+
+    def test_a_case_over_its_timeout_is_failed_and_kept_failed(self):
+        out = os.path.join(self.tmp, 'timeout')
+        grid = ['--grades', '0', '--cone-indices', '300', '--runner', 'core', '--progress', 'plain']
+        rc, so, se = doe('run', '--out', out, '--timeout', '2', *grid)
+        self.assertEqual(rc, 1, so + se)
+        r = load(os.path.join(out, 'runs', 'g0_ci300.result.yaml'))
+        self.assertEqual(r['status'], 'error')
+        self.assertIn('timed out after', r['error'])
+        self.assertFalse(os.path.exists(os.path.join(out, 'runs', 'g0_ci300.running')))
+        rc, so, _ = doe('run', '--out', out, '--resume', *grid)
+        self.assertEqual(rc, 1)
+        self.assertIn('failed before: g0_ci300: timed out after', so)
+        self.assertIn('0 to run', so)
 
     def test_bad_input_is_refused(self):
         for args, what in ((['--jobs', '0'], '--jobs'), (['--duration', '90'], '--duration'),
@@ -240,6 +254,36 @@ class SlurmDoe(unittest.TestCase):
             a, b = load(os.path.join(local, 'doe_table.yaml')), load(os.path.join(out, 'doe_table.yaml'))
             self.assertEqual(a['speed'], b['speed'])  # bit for bit: the runs are deterministic
             self.assertEqual([r['source'] for r in a['cases_table']], [r['source'] for r in b['cases_table']])
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+    def test_a_cancelled_task_is_recorded_failed_naming_its_state(self):
+        tmp = tempfile.mkdtemp(prefix='dm_doe_slurm_')
+        try:
+            with LocalCluster() as c:
+                out = os.path.join(tmp, 'cancelled')
+                grid = ['--grades', '0,1', '--cone-indices', '300', '--runner', 'core', '--no-prune']
+                rc, so, se = doe('run', '--out', out, '--backend', 'slurm', '--jobs', '1', '--no-wait', *grid, env=c.env)
+                self.assertEqual(rc, 0, so + se)
+                job = load(os.path.join(out, 'slurm', 'jobs.yaml'))['jobs'][0]['job']
+                marker = os.path.join(out, 'runs', 'g0_ci300.running')
+                t0 = time.time()
+                while not os.path.exists(marker) and time.time() - t0 < 60:
+                    time.sleep(0.2)
+                self.assertTrue(os.path.exists(marker), 'the first task never started')
+                # a task still pending or running: no resume
+                rc, _, se = doe('run', '--out', out, '--resume', '--backend', 'slurm', *grid, env=c.env)
+                self.assertEqual(rc, 2)
+                self.assertIn('still pending or running', se)
+                subprocess.run(['scancel', job], env=c.env, check=True)
+                for _ in range(100):
+                    rc, so, _ = doe('status', '--out', out, env=c.env)
+                    if 'failed 2' in so:
+                        break
+                    time.sleep(0.3)
+                self.assertIn('failed 2', so)
+                self.assertIn('ended CANCELLED', load(os.path.join(out, 'runs', 'g0_ci300.result.yaml'))['error'])
+                self.assertIn('recorded failed', so)
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
 
