@@ -479,17 +479,19 @@ def parser():
         p.add_argument('--cell-size', type=float, default=20.0, help='map cell size [m] (default 20)')
         p.add_argument('--oversample', type=int, default=2, help='slope posts per cell side (default 2)')
 
+    def design_args(p):  # the design's: plan and run take the same
+        grid_args(p)
+        map_args(p, required=False)
+        p.add_argument('--grid', choices=('paper', 'map'), default='paper',
+                       help='paper: 14 x 12 (default); map: --grid-size values over the ranges found on the map')
+        p.add_argument('--grid-size', type=grid_size, default=[14, 12], help='G x C for --grid map (default 14x12)')
+        p.add_argument('--level', default='tiny', help='soil fidelity level of the runs (default tiny)')
+
     p = sub.add_parser('plan', help='the grid, its run order and the estimated cost with and without pruning',
                        description='Prints the design: the grid (the paper\'s, the map\'s ranges or given), the '
                        'order the cases run in, and the estimated cost with and without pruning (a dry run: '
                        'nothing is simulated).')
-    grid_args(p)
-    map_args(p, required=False)
-    p.add_argument('--grid', choices=('paper', 'map'), default='paper',
-                   help='paper: 14 x 12 (default); map: --grid-size values over the ranges found on the map')
-    p.add_argument('--grid-size', type=grid_size, default=[14, 12],
-                   help='G x C for --grid map (default 14x12)')
-    p.add_argument('--level', default='tiny', help='soil fidelity level of the runs (default tiny)')
+    design_args(p)
     p.set_defaults(func=cmd_plan)
 
     p = sub.add_parser('run', help='runs the DOE\'s cases on a local pool or as a Slurm job array (resume, pruning, table, plots)',
@@ -498,12 +500,7 @@ def parser():
                        '--jobs at a time, in the plan\'s order, on a local pool or as one Slurm job array; a case whose outcome the finished ones fix is '
                        'recorded as implied, not run. Writes OUT/doe.yaml, OUT/runs/ (a result, log and bag per '
                        'case), OUT/doe_table.csv/.yaml and the plots. --resume keeps the finished cases.')
-    grid_args(p)
-    map_args(p, required=False)
-    p.add_argument('--grid', choices=('paper', 'map'), default='paper',
-                   help='paper: 14 x 12 (default); map: --grid-size values over the ranges found on the map')
-    p.add_argument('--grid-size', type=grid_size, default=[14, 12], help='G x C for --grid map (default 14x12)')
-    p.add_argument('--level', default='tiny', help='soil fidelity level of the runs (default tiny)')
+    design_args(p)
     p.add_argument('--runner', choices=('roslaunch', 'core'), default='roslaunch',
                    help='roslaunch (default: the launch files, a bag per case) or core (build/core\'s dm_run_scene: '
                    'the same loop in one process, no bag)')
