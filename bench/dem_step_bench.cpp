@@ -5,6 +5,9 @@
 //      ours four side walls), and
 //  (b) a poured, consolidated cohesive bed of 100,000 particles (config/scenes/dem_bench_bed.yaml,
 //      prepared by the dem_pour scene first; its preparation is timed too).
+// Per bed: the rates of the default pair kernel (the vector one, on the best instruction set the CPU
+// has) and of the scalar reference, the neighbour builds in the timed steps, and the contacts'
+// mean normal force and its parts (so that a reader sees what work the bed does).
 //   dem_step_bench [SOIL.yaml] [steps] [BED_B_SCENE.yaml | none]
 #include <algorithm>
 #include <chrono>
@@ -47,14 +50,48 @@ DemSystem ReferenceBed(const SoilParams& soil) {
   return s;
 }
 
-// particle-steps per second over `steps` timed steps of a copy of `s`, after 20 more warm-up steps
-double Rate(DemSystem s, int threads, int steps) {
+struct Timed {
+  double rate = 0.0;   // particle-steps per second
+  long rebuilds = 0;   // neighbour-list builds in the timed steps
+};
+
+// particle-steps per second over `steps` timed steps of a copy of `s` on `kernel`, after 20 more
+// warm-up steps
+Timed Rate(DemSystem s, int threads, int steps, PairKernel kernel = PairKernel::kAuto) {
   s.set_threads(threads);
+  s.set_pair_kernel(kernel);
   for (int i = 0; i < 20; ++i) s.Step();
+  const long builds0 = s.neighbour_builds();
   const auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < steps; ++i) s.Step();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return static_cast<double>(s.num_alive()) * steps / wall;
+  return Timed{static_cast<double>(s.num_alive()) * steps / wall, s.neighbour_builds() - builds0};
+}
+
+// The rates of the default (vector) kernel and of the scalar reference at 1 and 2 threads, the
+// rebuilds in the timed steps and the contacts at the end of the warm-up: the lines of one bed.
+void Report(const char* bed, const DemSystem& s, int steps) {
+  DemSystem warm = s;
+  for (int i = 0; i < 20; ++i) warm.Step();
+  const DemContactSummary c = warm.ContactSummary();
+  std::printf("dem_step %s_pair_kernel %s name\n", bed, PairKernelName(PairKernel::kAuto));
+  std::printf("dem_step %s_contacts_per_particle %.2f count\n", bed, 2.0 * c.contacts / s.num_alive());
+  std::printf("dem_step %s_mean_normal_force %.4g N\n", bed, c.mean_normal);
+  std::printf("dem_step %s_mean_adhesion %.4g N\n", bed, c.mean_adhesion);
+  std::printf("dem_step %s_mean_repulsion %.4g N\n", bed, c.mean_repulsion);
+  std::printf("dem_step %s_adhesive_contact_fraction %.3f ratio\n", bed, c.adhesive_fraction);
+  std::fflush(stdout);
+  const Timed v1 = Rate(s, 1, steps), v2 = Rate(s, 2, steps);
+  const Timed s1 = Rate(s, 1, steps, PairKernel::kScalar), s2 = Rate(s, 2, steps, PairKernel::kScalar);
+  std::printf("dem_step %s_rate_1thread %.3f Mparticle-steps/s\n", bed, v1.rate * 1e-6);
+  std::printf("dem_step %s_rate_2threads %.3f Mparticle-steps/s\n", bed, v2.rate * 1e-6);
+  std::printf("dem_step %s_speedup_1_to_2 %.3f x\n", bed, v2.rate / v1.rate);
+  std::printf("dem_step %s_rebuilds %ld count (in %d timed steps)\n", bed, v2.rebuilds, steps);
+  std::printf("dem_step %s_scalar_rate_1thread %.3f Mparticle-steps/s\n", bed, s1.rate * 1e-6);
+  std::printf("dem_step %s_scalar_rate_2threads %.3f Mparticle-steps/s\n", bed, s2.rate * 1e-6);
+  std::printf("dem_step %s_vector_over_scalar_2threads %.3f x\n", bed, v2.rate / s2.rate);
+  std::printf("dem_step %s_bytes_per_particle %.0f B\n", bed, static_cast<double>(s.MemoryBytes()) / s.num_alive());
+  std::fflush(stdout);
 }
 }  // namespace
 
@@ -65,12 +102,7 @@ int main(int argc, char** argv) {
   const DemSystem bed_a = ReferenceBed(soil);
   std::printf("dem_step bed_particles %d count\n", bed_a.num_alive());
   std::printf("dem_step bed_contacts %d count\n", bed_a.contacts());
-  const double a1 = Rate(bed_a, 1, steps), a2 = Rate(bed_a, 2, steps);
-  std::printf("dem_step bed_rate_1thread %.3f Mparticle-steps/s\n", a1 * 1e-6);
-  std::printf("dem_step bed_rate_2threads %.3f Mparticle-steps/s\n", a2 * 1e-6);
-  std::printf("dem_step bed_speedup_1_to_2 %.3f x\n", a2 / a1);
-  std::printf("dem_step bed_bytes_per_particle %.0f B\n", static_cast<double>(bed_a.MemoryBytes()) / bed_a.num_alive());
-  std::fflush(stdout);
+  Report("bed", bed_a, steps);
   const std::string bed_b = argc > 3 ? argv[3] : DM_CONFIG_DIR "/scenes/dem_bench_bed.yaml";
   if (bed_b == "none") return 0;
   const DemPourParams pp = DemPourParams::Read(YamlReader::Load(bed_b));
@@ -83,11 +115,6 @@ int main(int argc, char** argv) {
   std::printf("dem_step poured_particles %d count\n", bed->num_alive());
   std::printf("dem_step poured_preparation %.1f s (%.3f s simulated)\n", prep.wall_time, prep.sim_time);
   std::printf("dem_step poured_density %.0f kg/m^3\n", prep.density_consolidated);
-  std::printf("dem_step poured_contacts_per_particle %.2f count\n", 2.0 * bed->contacts() / bed->num_alive());
-  const double p1 = Rate(*bed, 1, steps), p2 = Rate(*bed, 2, steps);
-  std::printf("dem_step poured_rate_1thread %.3f Mparticle-steps/s\n", p1 * 1e-6);
-  std::printf("dem_step poured_rate_2threads %.3f Mparticle-steps/s\n", p2 * 1e-6);
-  std::printf("dem_step poured_speedup_1_to_2 %.3f x\n", p2 / p1);
-  std::printf("dem_step poured_bytes_per_particle %.0f B\n", static_cast<double>(bed->MemoryBytes()) / bed->num_alive());
+  Report("poured", *bed, steps);
   return 0;
 }

@@ -76,11 +76,18 @@ if [ "$want" = all ] || [ "$want" = dem_step ]; then
   ensure_packages "${DM_BENCH_PACKAGES[@]}" >/dev/null
   bed="$DM_ROOT/../shared/bench/lammps-bed.in"
   if [ -f "$bed" ]; then
-    (cd "$tmp" && lmp -in "$bed" >lmp1.log 2>&1 && mpirun --allow-run-as-root --oversubscribe -np 2 lmp -in "$bed" >lmp2.log 2>&1)
+    # the input as it is, with the mean normal contact force (pair/local force: the normal force of
+    # every pair in contact, repulsive > 0) printed at the end of the timed run
+    awk '/^run 1000/ { print "compute pf all pair/local force"; print "compute mf all reduce ave c_pf";
+         print "thermo_style custom step atoms c_mf"; print "thermo 1000" } { print }' "$bed" >"$tmp/bed.in"
+    (cd "$tmp" && lmp -in bed.in >lmp1.log 2>&1 && mpirun --allow-run-as-root --oversubscribe -np 2 lmp -in bed.in >lmp2.log 2>&1)
     rate() { awk '/Loop time of .* for 1000 steps/ {printf "%.3f", $(NF-1) * 1000 / $4 / 1e6}' "$1"; }
     l1=$(rate "$tmp/lmp1.log"); l2=$(rate "$tmp/lmp2.log")
     echo "dem_step lammps_rate_1rank $l1 Mparticle-steps/s"
     echo "dem_step lammps_rate_2ranks $l2 Mparticle-steps/s"
+    # the timed run's neighbour builds (the second run's line) and its last thermo line's mean force
+    echo "dem_step lammps_rebuilds $(awk '/Neighbor list builds/ {n = $NF} END {print n}' "$tmp/lmp2.log") count (in 1000 timed steps)"
+    echo "dem_step lammps_mean_normal_force $(awk '$1 == 1200 && NF == 3 {printf "%.4g", $3}' "$tmp/lmp2.log") N"
     ours=$(awk '/bed_rate_2threads/ {print $3}' "$tmp/dem.txt")
     echo "dem_step lammps_ratio_2threads $(python3 -c "print(round($ours / $l2, 3))") ratio"
   else

@@ -23,6 +23,7 @@ DemSystem::DemSystem(const SoilParams& soil, const DemSettings& settings)
   DM_THROW_UNLESS(settings.max_overlap > 0.0 && settings.max_overlap < 1.0, "DEM max_overlap ",
                   settings.max_overlap, " must lie in (0, 1)");
   DM_THROW_UNLESS(settings.list_slack >= 0, "DEM list_slack ", settings.list_slack, " must be >= 0");
+  settings_.pair_kernel = ResolvePairKernel(settings.pair_kernel);
   mass_ = soil.Mass();
   cutoff_ = soil.diameter * (1.0 + settings.skin);
 }
@@ -93,6 +94,8 @@ void DemSystem::set_threads(int threads) {
   settings_.threads = threads;
 }
 
+void DemSystem::set_pair_kernel(PairKernel kernel) { settings_.pair_kernel = ResolvePairKernel(kernel); }
+
 std::vector<Vector3d> DemSystem::positions() const {
   std::vector<Vector3d> out(size());
   for (int id = 0; id < size(); ++id) out[id] = position(id);
@@ -156,7 +159,7 @@ void DemSystem::ComputeForces() {
     ps_.f[i] = ps_.live(i) ? weight : Vector3d::Zero();
     ps_.max_repulsion[i] = ps_.max_tension[i] = ps_.overlap[i] = 0.0;
   }
-  SweepPairs(law_, soil_.diameter, dt_, T, &ps_, &lists_);
+  SweepPairs(law_, soil_.diameter, dt_, T, &ps_, &lists_, settings_.pair_kernel);
   ledger_.wall_power = walls_.Compute(&ps_, dt_, T);
 }
 
@@ -169,16 +172,20 @@ void DemSystem::Step() {
   std::vector<Vector3d>& v = ps_.v;
   const std::vector<Vector3d>& f = ps_.f;
   double max_disp2 = 0.0;
-#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(max : max_disp2)
+  int tripped = n;  // the lowest slot a watchdog trips on
+#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(max : max_disp2) reduction(min : tripped)
   for (int i = 0; i < n; ++i) {
-    if (!ps_.live(i) || ps_.held[i]) continue;
-    v[i] += h * inv_m * f[i];
-    x[i] += dt_ * v[i];
-    max_disp2 = std::max(max_disp2, (x[i] - ps_.x_built[i]).squaredNorm());
+    if (!ps_.live(i)) continue;
+    if (!ps_.held[i]) {
+      v[i] += h * inv_m * f[i];
+      x[i] += dt_ * v[i];
+      max_disp2 = std::max(max_disp2, (x[i] - ps_.x_built[i]).squaredNorm());
+    }
+    if (StateTrips(ps_, i, dt_, half_skin)) tripped = std::min(tripped, i);
   }
   time_ += dt_;
   ++step_;
-  CheckParticleStates(ps_, dt_, half_skin, step_, time_);
+  if (tripped < n) ReportStateTrip(ps_, tripped, dt_, half_skin, step_, time_);
   walls_.UpdateVertices();  // the walls' poses were set for this step from outside
   if (rebuild_ || max_disp2 > half_skin * half_skin || walls_.MaxWallDisplacement(false) > half_skin)
     Rebuild();  // the particles or a slow wall moved half the skin
@@ -187,7 +194,11 @@ void DemSystem::Step() {
   const double power_before = ledger_.wall_power;
   ComputeForces();
   ledger_.wall_work += h * (power_before + ledger_.wall_power);  // trapezoidal
-  CheckParticleOverlaps(ps_, soil_.diameter, settings_.max_overlap, step_, time_);
+  const double overlap_limit = settings_.max_overlap * soil_.diameter;
+#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(min : tripped)
+  for (int i = 0; i < n; ++i)
+    if (ps_.live(i) && OverlapTrips(ps_, i, overlap_limit)) tripped = std::min(tripped, i);
+  if (tripped < n) ReportOverlapTrip(ps_, tripped, soil_.diameter, settings_.max_overlap, step_, time_);
 #pragma omp parallel for schedule(static) num_threads(settings_.threads)
   for (int i = 0; i < n; ++i) {
     if (!ps_.live(i)) continue;
@@ -211,6 +222,37 @@ EnergyReport DemSystem::Energy() const {
   e.exchanged = ledger_.exchanged;
   e.dissipated = ledger_.wall_work + ledger_.exchanged - (e.Total() - ledger_.e0);
   return e;
+}
+
+DemContactSummary DemSystem::ContactSummary() const {
+  DemContactSummary out;
+  const double D = soil_.diameter;
+  double normal = 0.0, adhesion = 0.0, repulsion = 0.0;
+  long adhesive = 0;
+  auto pair = [&](int i, int j) {
+    const Vector3d r = ps_.x[i] - ps_.x[j];
+    const double dist = r.norm(), d = D - dist - (ps_.plastic[i] + ps_.plastic[j]);
+    if (!(d > 0.0) || dist <= 0.0) return;
+    const double vn = (ps_.v[i] - ps_.v[j]).dot(r / dist);
+    const SoilNormalForce fn = law_.Normal(d, -vn, std::min(ps_.adhesion_max[i], ps_.adhesion_max[j]));
+    ++out.contacts;
+    normal += fn.Total();
+    adhesion += fn.adhesion;
+    repulsion += fn.repulsion;
+    adhesive += d < law_.d0;
+  };
+  for (int i = 0; i < ps_.slots(); ++i) {
+    if (!ps_.live(i)) continue;
+    for (int k = lists_.begin(i); k < lists_.end(i); ++k) pair(i, lists_.partners()[k]);
+  }
+  if (out.contacts > 0) {
+    const double n = static_cast<double>(out.contacts);
+    out.mean_normal = normal / n;
+    out.mean_adhesion = adhesion / n;
+    out.mean_repulsion = repulsion / n;
+    out.adhesive_fraction = adhesive / n;
+  }
+  return out;
 }
 
 size_t DemSystem::MemoryBytes() const { return ps_.MemoryBytes() + lists_.MemoryBytes() + walls_.MemoryBytes(); }

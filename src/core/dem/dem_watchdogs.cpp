@@ -31,30 +31,23 @@ TimeStepLimit DemCriticalTimeStep(const SoilParams& soil, double mass, int max_c
   return lim;
 }
 
-void CheckParticleStates(const ParticleStore& ps, double dt, double half_skin, long step, double time) {
-  for (int i = 0; i < ps.slots(); ++i) {
-    if (!ps.live(i)) continue;
-    const Eigen::Vector3d& x = ps.x[i];
-    const Eigen::Vector3d& v = ps.v[i];
-    if (!(x.allFinite() && v.allFinite()))
-      throw SimulationError(detail::Concat("DEM step ", step, " (t = ", time, " s): particle ", ps.id_of_slot[i],
-                                           " has a non-finite state (x = ", x.transpose(), ", v = ", v.transpose(),
-                                           "); the time step is too large or an input is NaN"));
-    const double move = v.norm() * dt;
-    if (move > half_skin)
-      throw SimulationError(detail::Concat("DEM step ", step, " (t = ", time, " s): particle ", ps.id_of_slot[i],
-                                           " moved ", move, " m in one step, more than half the skin (", half_skin,
-                                           " m); its speed is ", v.norm(), " m/s"));
-  }
+void ReportStateTrip(const ParticleStore& ps, int i, double dt, double half_skin, long step, double time) {
+  const Eigen::Vector3d& x = ps.x[i];
+  const Eigen::Vector3d& v = ps.v[i];
+  if (!(x.allFinite() && v.allFinite()))
+    throw SimulationError(detail::Concat("DEM step ", step, " (t = ", time, " s): particle ", ps.id_of_slot[i],
+                                         " has a non-finite state (x = ", x.transpose(), ", v = ", v.transpose(),
+                                         "); the time step is too large or an input is NaN"));
+  const double move = v.norm() * dt;
+  throw SimulationError(detail::Concat("DEM step ", step, " (t = ", time, " s): particle ", ps.id_of_slot[i], " moved ",
+                                       move, " m in one step, more than half the skin (", half_skin,
+                                       " m); its speed is ", v.norm(), " m/s"));
 }
 
-void CheckParticleOverlaps(const ParticleStore& ps, double diameter, double max_overlap, long step, double time) {
-  const double limit = max_overlap * diameter;
-  for (int i = 0; i < ps.slots(); ++i)
-    if (ps.live(i) && (ps.overlap[i] > limit || !ps.f[i].allFinite()))
-      throw SimulationError(detail::Concat("DEM step ", step, " (t = ", time, " s): particle ", ps.id_of_slot[i],
-                                           !ps.f[i].allFinite() ? " has a non-finite force" : " overlaps a neighbour or a wall by ",
-                                           ps.overlap[i] / diameter, " of the diameter (limit ", max_overlap, ")"));
+void ReportOverlapTrip(const ParticleStore& ps, int i, double diameter, double max_overlap, long step, double time) {
+  throw SimulationError(detail::Concat("DEM step ", step, " (t = ", time, " s): particle ", ps.id_of_slot[i],
+                                       !ps.f[i].allFinite() ? " has a non-finite force" : " overlaps a neighbour or a wall by ",
+                                       ps.overlap[i] / diameter, " of the diameter (limit ", max_overlap, ")"));
 }
 
 }  // namespace dem_mobility::core

@@ -1,14 +1,25 @@
+// The pair sweep and its two kernels (see pair_sweep.h). This file is compiled with
+// -ffp-contract=off (no fused multiply-adds: every instance rounds as the scalar law does),
+// -fno-math-errno and -fno-trapping-math (sqrt and division may run on lanes whose result is then
+// discarded); none of these changes a result.
 #include "dem_mobility/core/dem/pair_sweep.h"
 
 #include <algorithm>
 #include <cmath>
 
+#include "dem_mobility/core/common/error.h"
+
 namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
-void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
-                NeighbourList* lists) {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// the scalar reference: the soil law's per-pair functions, one contact after the other
+
+void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
+                 NeighbourList* lists) {
   const double D = diameter, D2 = D * D;
   std::vector<Vector3d>& x = ps->x;
   std::vector<Vector3d>& v = ps->v;
@@ -80,6 +91,305 @@ void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threa
         if (state[i] == SlotState::kListed) sweep(i);
       for (const int i : lists->slab_added(sl)) sweep(i);
     }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// the vector kernel
+
+constexpr int kBlock = 16;  // partners per block (a particle's half list holds 4-10 in a packed bed)
+constexpr int kPad = 8;     // a block's lanes are computed in multiples of this (one AVX-512 vector)
+
+// The law's constants as the block loop reads them (the scalar law's, worked out the same way).
+struct LawConstants {
+  double D, D2, dt, k_n, c_n, d0, inv_dp, inv_d0_dp, s_n;
+  double mu, k_t, inv_k_t, v_slip, c_visc;
+  bool cohesion;
+};
+
+// The sweep's arrays (what the scalar kernel reads through ps and lists).
+struct SweepArrays {
+  const HotParticle* hot;
+  Vector3d* f;
+  double *max_repulsion, *max_tension, *overlap;
+  const int *nbr_begin, *nbr_end, *nbr;
+  TangentialHistory* hist;
+  unsigned char* touching;
+};
+
+// One block's lanes: inputs gathered, outputs of the law.
+struct alignas(64) Block {
+  double rx[kBlock], ry[kBlock], rz[kBlock];     // x_i - x_j
+  double vx[kBlock], vy[kBlock], vz[kBlock];     // v_i - v_j
+  double psum[kBlock], amax[kBlock];             // plastic_i + plastic_j, min(adhesion_i, adhesion_j)
+  double sx[kBlock], sy[kBlock], sz[kBlock];     // the anchor spring: in, and out
+  double fx[kBlock], fy[kBlock], fz[kBlock];     // the contact force on i
+  double rep[kBlock], ten[kBlock], ovl[kBlock];  // repulsion, tension (-adhesion), overlap
+  double skin[kBlock], contact[kBlock];          // 1: within the diameter; 1: in contact (d > 0)
+};
+
+// The law on lanes [0, n) of a block, n a multiple of kPad: the scalar law's operations in its
+// order (sums associated as Eigen's: (a0 b0 + a1 b1) + a2 b2), its branches as selects (the soil's
+// cohesion switch as a template argument: the vectoriser takes no select on a loop-invariant bool).
+template <bool kCohesion>
+[[gnu::always_inline]] inline void BlockLaw(const LawConstants& law, int n, Block* __restrict b) {
+  const LawConstants c = law;  // in registers: no constant is loaded under a lane's condition
+  for (int l = 0; l < n; ++l) {
+    const double rx = b->rx[l], ry = b->ry[l], rz = b->rz[l];
+    const double r2 = (rx * rx + ry * ry) + rz * rz;
+    const double dist = std::sqrt(r2);
+    const double overlap = c.D - dist;
+    const double d = overlap - b->psum[l];
+    const bool skin = r2 < c.D2;
+    const bool contact = skin & (d > 0.0) & (dist > 0.0);
+    const double inv = 1.0 / dist;
+    const double nx = rx * inv, ny = ry * inv, nz = rz * inv;
+    const double vx = b->vx[l], vy = b->vy[l], vz = b->vz[l];
+    const double vn = (vx * nx + vy * ny) + vz * nz;
+    // the normal force (SoilContactLaw::Normal) at d, d_dot = -vn
+    const double d_dot = -vn;
+    const double fa = std::max(0.0, b->amax[l]);
+    const double tri = std::max(0.0, std::min(d * c.inv_dp, (c.d0 - d) * c.inv_d0_dp));
+    const double adhesion = kCohesion ? -fa * tri : 0.0;
+    const double repulsion = c.k_n * std::max(0.0, d - c.d0);
+    const double damping = c.c_n * (std::max(d_dot, 0.0) + c.s_n * std::min(d_dot, 0.0));
+    const double total = (adhesion + repulsion) + damping;
+    // the tangential force (SoilContactLaw::Tangential, AsperityFriction::Force)
+    const double vtx = vx - vn * nx, vty = vy - vn * ny, vtz = vz - vn * nz;
+    double sx = b->sx[l], sy = b->sy[l], sz = b->sz[l];
+    const double sn = (sx * nx + sy * ny) + sz * nz;
+    sx -= sn * nx;
+    sy -= sn * ny;
+    sz -= sn * nz;
+    sx += vtx * c.dt;
+    sy += vty * c.dt;
+    sz += vtz * c.dt;
+    const double vt_norm = std::sqrt((vtx * vtx + vty * vty) + vtz * vtz);
+    const double cc = -c.mu * repulsion / std::max(c.v_slip, vt_norm);
+    const double fcx = cc * vtx, fcy = cc * vty, fcz = cc * vtz;
+    double ftx = -c.k_t * sx + fcx, fty = -c.k_t * sy + fcy, ftz = -c.k_t * sz + fcz;
+    const double limit = c.mu * std::max(0.0, repulsion);
+    const double ft2 = (ftx * ftx + fty * fty) + ftz * ftz;
+    const bool slip = ft2 > limit * limit;
+    const double scale = ft2 > 0.0 ? limit / std::sqrt(ft2) : 0.0;
+    const double stx = ftx * scale, sty = fty * scale, stz = ftz * scale;
+    ftx = slip ? stx : ftx;
+    fty = slip ? sty : fty;
+    ftz = slip ? stz : ftz;
+    b->sx[l] = slip ? -(ftx - fcx) * c.inv_k_t : sx;
+    b->sy[l] = slip ? -(fty - fcy) * c.inv_k_t : sy;
+    b->sz[l] = slip ? -(ftz - fcz) * c.inv_k_t : sz;
+    ftx -= c.c_visc * vtx;
+    fty -= c.c_visc * vty;
+    ftz -= c.c_visc * vtz;
+    b->fx[l] = total * nx + ftx;
+    b->fy[l] = total * ny + fty;
+    b->fz[l] = total * nz + ftz;
+    b->rep[l] = repulsion;
+    b->ten[l] = -adhesion;
+    b->ovl[l] = overlap;
+    b->skin[l] = skin ? 1.0 : 0.0;
+    b->contact[l] = contact ? 1.0 : 0.0;
+  }
+}
+
+// The pairs of slot i: gathered block by block, the law on each block's lanes, the results
+// scattered in list order (the scalar kernel's order of sums and maxima).
+template <bool kCohesion>
+[[gnu::always_inline]] inline void SweepParticle(const LawConstants& c, const SweepArrays& a, int i, Block* b) {
+  const HotParticle& pi = a.hot[i];
+  const double xi0 = pi.x[0], xi1 = pi.x[1], xi2 = pi.x[2];
+  const double vi0 = pi.v[0], vi1 = pi.v[1], vi2 = pi.v[2];
+  const double plastic_i = pi.plastic, adhesion_i = pi.adhesion_max;
+  double fi0 = 0.0, fi1 = 0.0, fi2 = 0.0;
+  double max_rep = a.max_repulsion[i], max_ten = a.max_tension[i], max_overlap = a.overlap[i];
+  for (int k0 = a.nbr_begin[i]; k0 < a.nbr_end[i]; k0 += kBlock) {
+    const int m = std::min(kBlock, a.nbr_end[i] - k0);
+    for (int l = 0; l < m; ++l) {
+      const HotParticle& pj = a.hot[a.nbr[k0 + l]];
+      b->rx[l] = xi0 - pj.x[0];
+      b->ry[l] = xi1 - pj.x[1];
+      b->rz[l] = xi2 - pj.x[2];
+      b->vx[l] = vi0 - pj.v[0];
+      b->vy[l] = vi1 - pj.v[1];
+      b->vz[l] = vi2 - pj.v[2];
+      b->psum[l] = plastic_i + pj.plastic;
+      b->amax[l] = std::min(adhesion_i, pj.adhesion_max);
+      const Vector3d& s = a.hist[k0 + l].spring;
+      b->sx[l] = s.x();
+      b->sy[l] = s.y();
+      b->sz[l] = s.z();
+    }
+    const int n = (m + kPad - 1) / kPad * kPad;
+    for (int l = m; l < n; ++l) {  // padding: apart by two diameters, at rest, no contact
+      b->rx[l] = b->ry[l] = b->rz[l] = 2.0 * c.D;
+      b->vx[l] = b->vy[l] = b->vz[l] = b->psum[l] = b->amax[l] = 0.0;
+      b->sx[l] = b->sy[l] = b->sz[l] = 0.0;
+    }
+    BlockLaw<kCohesion>(c, n, b);
+    for (int l = 0; l < m; ++l) {
+      const int k = k0 + l;
+      if (b->contact[l] == 0.0) {
+        if (b->skin[l] != 0.0) {
+          max_overlap = std::max(max_overlap, b->ovl[l]);
+          double& oj = a.overlap[a.nbr[k]];
+          oj = std::max(oj, b->ovl[l]);
+        }
+        if (a.touching[k]) {
+          a.hist[k] = TangentialHistory();
+          a.touching[k] = 0;
+        }
+        continue;
+      }
+      const int j = a.nbr[k];
+      max_overlap = std::max(max_overlap, b->ovl[l]);
+      a.overlap[j] = std::max(a.overlap[j], b->ovl[l]);
+      fi0 += b->fx[l];
+      fi1 += b->fy[l];
+      fi2 += b->fz[l];
+      Vector3d& fj = a.f[j];
+      fj.x() -= b->fx[l];
+      fj.y() -= b->fy[l];
+      fj.z() -= b->fz[l];
+      max_rep = std::max(max_rep, b->rep[l]);
+      max_ten = std::max(max_ten, b->ten[l]);
+      a.max_repulsion[j] = std::max(a.max_repulsion[j], b->rep[l]);
+      a.max_tension[j] = std::max(a.max_tension[j], b->ten[l]);
+      a.hist[k].spring = Vector3d(b->sx[l], b->sy[l], b->sz[l]);
+      a.touching[k] = 1;
+    }
+  }
+  Vector3d& f = a.f[i];
+  f.x() += fi0;
+  f.y() += fi1;
+  f.z() += fi2;
+  a.max_repulsion[i] = max_rep;
+  a.max_tension[i] = max_ten;
+  a.overlap[i] = max_overlap;
+}
+
+// One slab: its listed slots in ascending order, then those added since the build.
+[[gnu::always_inline]] inline void SweepSlabBody(const LawConstants& c, const SweepArrays& a, const SlotState* state,
+                                                 int begin, int end, const std::vector<int>& added) {
+  Block b;
+  if (c.cohesion) {
+    for (int i = begin; i < end; ++i)
+      if (state[i] == SlotState::kListed) SweepParticle<true>(c, a, i, &b);
+    for (const int i : added) SweepParticle<true>(c, a, i, &b);
+  } else {
+    for (int i = begin; i < end; ++i)
+      if (state[i] == SlotState::kListed) SweepParticle<false>(c, a, i, &b);
+    for (const int i : added) SweepParticle<false>(c, a, i, &b);
+  }
+}
+
+using SlabFunction = void (*)(const LawConstants&, const SweepArrays&, const SlotState*, int, int,
+                              const std::vector<int>&);
+
+// The instances: one body, compiled for each instruction set (the body is inlined into each).
+__attribute__((target("arch=x86-64-v4"))) void SweepSlabAvx512(const LawConstants& c, const SweepArrays& a,
+                                                                const SlotState* state, int begin, int end,
+                                                                const std::vector<int>& added) {
+  SweepSlabBody(c, a, state, begin, end, added);
+}
+__attribute__((target("arch=x86-64-v3"))) void SweepSlabAvx2(const LawConstants& c, const SweepArrays& a,
+                                                              const SlotState* state, int begin, int end,
+                                                              const std::vector<int>& added) {
+  SweepSlabBody(c, a, state, begin, end, added);
+}
+void SweepSlabBaseline(const LawConstants& c, const SweepArrays& a, const SlotState* state, int begin, int end,
+                       const std::vector<int>& added) {
+  SweepSlabBody(c, a, state, begin, end, added);
+}
+
+bool CpuHasAvx512() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+         __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx2") &&
+         __builtin_cpu_supports("fma");
+}
+bool CpuHasAvx2() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi2");
+}
+
+void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, double dt, int threads,
+                 ParticleStore* ps, NeighbourList* lists) {
+  const int n = ps->slots();
+  if (static_cast<int>(ps->hot.size()) != n) ps->hot.resize(n);  // only when slots were appended
+  HotParticle* hot = ps->hot.data();
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int i = 0; i < n; ++i) {
+    HotParticle& h = hot[i];
+    const Vector3d& xi = ps->x[i];
+    const Vector3d& vi = ps->v[i];
+    h.x[0] = xi.x();
+    h.x[1] = xi.y();
+    h.x[2] = xi.z();
+    h.v[0] = vi.x();
+    h.v[1] = vi.y();
+    h.v[2] = vi.z();
+    h.plastic = ps->plastic[i];
+    h.adhesion_max = ps->adhesion_max[i];
+  }
+  const AsperityFriction& fr = law.friction;
+  const LawConstants c{diameter, diameter * diameter, dt,   law.k_n,  law.c_n, law.d0,   law.inv_dp,  law.inv_d0_dp,
+                       law.s_n,  fr.mu,                 fr.k_t, fr.inv_k_t, fr.v_slip, fr.c_visc, law.cohesion};
+  const SweepArrays a{hot,
+                      ps->f.data(),
+                      ps->max_repulsion.data(),
+                      ps->max_tension.data(),
+                      ps->overlap.data(),
+                      lists->list_begin().data(),
+                      lists->list_end().data(),
+                      lists->partners().data(),
+                      lists->histories().data(),
+                      lists->touching().data()};
+  const SlotState* state = ps->state.data();
+  const int ns = lists->num_slabs();
+  for (int colour = 0; colour < 2; ++colour) {
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int sl = colour; sl < ns; sl += 2)
+      slab(c, a, state, lists->slab_start(sl), lists->slab_start(sl + 1), lists->slab_added(sl));
+  }
+}
+
+}  // namespace
+
+PairKernel ResolvePairKernel(PairKernel requested) {
+  switch (requested) {
+    case PairKernel::kAuto:
+      return CpuHasAvx512() ? PairKernel::kVectorAvx512
+                            : (CpuHasAvx2() ? PairKernel::kVectorAvx2 : PairKernel::kVectorBaseline);
+    case PairKernel::kVectorAvx512:
+      DM_THROW_UNLESS(CpuHasAvx512(), "pair kernel vector-avx512: this CPU lacks AVX-512 (F, VL, DQ, BW)");
+      return requested;
+    case PairKernel::kVectorAvx2:
+      DM_THROW_UNLESS(CpuHasAvx2(), "pair kernel vector-avx2: this CPU lacks AVX2, FMA or BMI2");
+      return requested;
+    case PairKernel::kVectorBaseline:
+    case PairKernel::kScalar:
+      return requested;
+  }
+  return PairKernel::kScalar;
+}
+
+const char* PairKernelName(PairKernel kernel) {
+  switch (ResolvePairKernel(kernel)) {
+    case PairKernel::kVectorAvx512: return "vector-avx512";
+    case PairKernel::kVectorAvx2: return "vector-avx2";
+    case PairKernel::kVectorBaseline: return "vector-baseline";
+    default: return "scalar";
+  }
+}
+
+void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
+                NeighbourList* lists, PairKernel kernel) {
+  switch (kernel == PairKernel::kAuto ? ResolvePairKernel(kernel) : kernel) {
+    case PairKernel::kVectorAvx512: return SweepVector(SweepSlabAvx512, law, diameter, dt, threads, ps, lists);
+    case PairKernel::kVectorAvx2: return SweepVector(SweepSlabAvx2, law, diameter, dt, threads, ps, lists);
+    case PairKernel::kVectorBaseline: return SweepVector(SweepSlabBaseline, law, diameter, dt, threads, ps, lists);
+    default: return SweepScalar(law, diameter, dt, threads, ps, lists);
   }
 }
 

@@ -86,7 +86,7 @@ void ParticleStore::Permute(const std::vector<int>& order) {
 size_t ParticleStore::MemoryBytes() const {
   auto bytes = [](const auto& a) { return a.capacity() * sizeof(a[0]); };
   return bytes(x) + bytes(v) + bytes(f) + bytes(x_built) + bytes(plastic) + bytes(adhesion_max) +
-         bytes(max_repulsion) + bytes(max_tension) + bytes(overlap) + bytes(state) + bytes(held) + bytes(id_of_slot) +
+         bytes(max_repulsion) + bytes(max_tension) + bytes(overlap) + bytes(state) + bytes(held) + bytes(id_of_slot) + bytes(hot) +
          bytes(ids_) + bytes(free_slots_);
 }
 

@@ -26,11 +26,22 @@
 #include "dem_mobility/core/common/time_step.h"
 #include "dem_mobility/core/dem/dem_energy.h"
 #include "dem_mobility/core/dem/neighbour_list.h"
+#include "dem_mobility/core/dem/pair_sweep.h"
 #include "dem_mobility/core/dem/particle_store.h"
 #include "dem_mobility/core/dem/soil_law.h"
 #include "dem_mobility/core/dem/wall_contacts.h"
 
 namespace dem_mobility::core {
+
+/// The pair contacts of the last force evaluation, summarised (what a benchmark prints so that a
+/// reader sees what work its bed does): normal forces are signed, > 0 repulsive.
+struct DemContactSummary {
+  long contacts = 0;              ///< pairs with a positive effective penetration
+  double mean_normal = 0.0;       ///< mean normal force (adhesion + repulsion + damping) [N]
+  double mean_adhesion = 0.0;     ///< mean adhesive part (<= 0) [N]
+  double mean_repulsion = 0.0;    ///< mean repulsive part [N]
+  double adhesive_fraction = 0.0; ///< of the contacts, those inside the adhesion range (d < d0)
+};
 
 struct DemSettings {
   double skin = 0.1;            ///< Verlet skin as a fraction of the diameter
@@ -40,6 +51,8 @@ struct DemSettings {
   int max_coordination = 12;    ///< contacts per particle assumed by the time-step guard
   int list_slack = 2;           ///< spare neighbour slots per particle for particles added later
   bool wall_bins = true;        ///< bin large walls' triangles (false: scan them all; same results)
+  /// the pair kernel (pair_sweep.h): every choice gives the same results, bit for bit
+  PairKernel pair_kernel = PairKernel::kAuto;
 };
 
 class DemSystem {
@@ -104,6 +117,10 @@ class DemSystem {
   }
   /// OpenMP threads from the next step on (the results do not depend on it).
   void set_threads(int threads);
+  /// The pair kernel from the next step on (kAuto resolved; a vector instance the CPU lacks is
+  /// refused); the results do not depend on it.
+  void set_pair_kernel(PairKernel kernel);
+  PairKernel pair_kernel() const { return settings_.pair_kernel; }
   // all particles, indexed by ID (copies: the storage is kept sorted by cell, not by ID)
   std::vector<Eigen::Vector3d> positions() const;
   std::vector<Eigen::Vector3d> velocities() const;
@@ -119,6 +136,9 @@ class DemSystem {
   /// Of those, the builds forced by an added particle whose neighbour's list had no room left.
   long overflow_builds() const { return overflow_builds_; }
   int contacts() const { return lists_.contacts(); }  ///< pairs in contact at the last force evaluation
+  /// The pair contacts at the present state (the normal law on every listed pair; cheap enough for a
+  /// report, not for every step).
+  DemContactSummary ContactSummary() const;
   /// The energies now and the ledger since Finalize() (see EnergyReport: the ledger is kept).
   EnergyReport Energy() const;
   /// Bytes held for the particles, neighbour lists, contact histories and walls.

@@ -2,6 +2,17 @@
 // slabs are swept by colour, the even slabs in parallel and then the odd ones (see
 // neighbour_list.h), each slab by one thread in ascending slot order: every particle's force is
 // summed in the same order for any number of threads.
+//
+// Two kernels compute the same law:
+//  - the scalar one, the soil law's per-pair functions (SoilContactLaw::Normal, Tangential) one
+//    contact after the other: the reference;
+//  - the vector one: a particle's partners in blocks (structure of arrays gathered from each
+//    partner's one-cache-line hot record and from the contact histories), the law written without
+//    branches over the block's lanes so that the compiler vectorises it, then the forces scattered
+//    in the scalar kernel's order. It is compiled three times, for x86-64-v4 (AVX-512), x86-64-v3
+//    (AVX2, FMA) and the x86-64 baseline (SSE2), and the best the CPU has is taken at run time
+//    (kAuto). Floating-point contraction is off in that file and every sum is associated as
+//    Eigen's are, so all of its instances give the scalar kernel's results bit for bit.
 #pragma once
 
 #include "dem_mobility/core/dem/neighbour_list.h"
@@ -10,9 +21,23 @@
 
 namespace dem_mobility::core {
 
+enum class PairKernel {
+  kAuto,             ///< the vector kernel for the best instruction set the CPU has
+  kVectorAvx512,     ///< the vector kernel, x86-64-v4 (AVX-512F/VL/DQ/BW)
+  kVectorAvx2,       ///< the vector kernel, x86-64-v3 (AVX2, FMA)
+  kVectorBaseline,   ///< the vector kernel, x86-64 baseline (SSE2)
+  kScalar,           ///< the scalar reference
+};
+
+/// kAuto resolved for this CPU; a vector instance the CPU cannot run is refused (ConfigError).
+PairKernel ResolvePairKernel(PairKernel requested);
+/// "vector-avx512", "vector-avx2", "vector-baseline", "scalar" (kAuto: what it resolves to).
+const char* PairKernelName(PairKernel kernel);
+
 /// Adds the pair forces to ps->f (set beforehand to the weights) and records each particle's
-/// largest repulsion, tension and overlap (reset beforehand); updates the contact histories.
+/// largest repulsion, tension and overlap (reset beforehand); updates the contact histories. The
+/// vector kernels first pack each slot's hot record (ps->hot).
 void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
-                NeighbourList* lists);
+                NeighbourList* lists, PairKernel kernel = PairKernel::kAuto);
 
 }  // namespace dem_mobility::core

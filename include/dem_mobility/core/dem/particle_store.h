@@ -37,6 +37,14 @@ void PermuteSlots(std::vector<T>* v, const std::vector<int>& order, size_t width
               old.begin() + static_cast<size_t>(order[s] + 1) * width, v->begin() + s * width);
 }
 
+/// What the pair sweep reads of a partner, packed into one cache line (written before each sweep
+/// from the per-slot arrays below; the vector kernels gather from it).
+struct alignas(64) HotParticle {
+  double x[3], v[3];
+  double plastic, adhesion_max;
+};
+static_assert(sizeof(HotParticle) == 64, "one cache line");
+
 class ParticleStore {
  public:
   static constexpr int kNoId = -1;
@@ -52,6 +60,9 @@ class ParticleStore {
   /// 1: held in place (zero velocity, not integrated; its contacts still act on its neighbours)
   std::vector<unsigned char> held;
   std::vector<int> id_of_slot;  ///< the ID whose (last) state the slot holds, or kNoId
+  /// x, v, plastic and adhesion_max of every slot, packed by the vector pair kernels before each
+  /// sweep (sized to slots() there; a scratch copy, never the state)
+  std::vector<HotParticle> hot;
 
   int slots() const { return static_cast<int>(x.size()); }
   bool live(int s) const { return state[s] != SlotState::kFree; }

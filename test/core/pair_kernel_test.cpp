@@ -1,0 +1,218 @@
+// The pair kernels: the vector kernel (each instance this CPU can run) gives the scalar reference's
+// forces, maxima, overlaps and contact histories bit for bit, on random pairs that reach every
+// branch of the law, and a DEM run on it gives the scalar run's states bit for bit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/dem/dem_shapes.h"
+#include "dem_mobility/core/dem/dem_system.h"
+#include "dem_mobility/core/dem/neighbour_list.h"
+#include "dem_mobility/core/dem/pair_sweep.h"
+#include "dem_test_soils.h"
+
+namespace dem_mobility::core {
+namespace {
+
+using Eigen::Vector3d;
+
+bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool SameBits(const Vector3d& a, const Vector3d& b) {
+  return SameBits(a.x(), b.x()) && SameBits(a.y(), b.y()) && SameBits(a.z(), b.z());
+}
+
+// The vector instances this CPU can run.
+std::vector<PairKernel> VectorKernels() {
+  std::vector<PairKernel> out{PairKernel::kVectorBaseline};
+  for (PairKernel k : {PairKernel::kVectorAvx2, PairKernel::kVectorAvx512}) try {
+      ResolvePairKernel(k);
+      out.push_back(k);
+    } catch (const ConfigError&) {
+      std::printf("pair kernel %d: not on this CPU, not tested\n", static_cast<int>(k));
+    }
+  return out;
+}
+
+// What one sweep produces.
+struct SweepOut {
+  std::vector<Vector3d> f, spring;
+  std::vector<double> max_repulsion, max_tension, overlap;
+  std::vector<unsigned char> touching;
+};
+
+SweepOut Sweep(const SoilContactLaw& law, double D, double dt, int threads, ParticleStore ps, NeighbourList lists,
+               PairKernel kernel) {
+  for (int i = 0; i < ps.slots(); ++i) {
+    ps.f[i].setZero();
+    ps.max_repulsion[i] = ps.max_tension[i] = ps.overlap[i] = 0.0;
+  }
+  SweepPairs(law, D, dt, threads, &ps, &lists, kernel);
+  SweepOut o{ps.f, {}, ps.max_repulsion, ps.max_tension, ps.overlap, lists.touching()};
+  for (const TangentialHistory& h : lists.histories()) o.spring.push_back(h.spring);
+  return o;
+}
+
+void ExpectSameBits(const SweepOut& a, const SweepOut& b, const char* what) {
+  ASSERT_EQ(a.f.size(), b.f.size());
+  int bad = 0;
+  for (size_t i = 0; i < a.f.size(); ++i)
+    bad += !SameBits(a.f[i], b.f[i]) || !SameBits(a.max_repulsion[i], b.max_repulsion[i]) ||
+           !SameBits(a.max_tension[i], b.max_tension[i]) || !SameBits(a.overlap[i], b.overlap[i]);
+  for (size_t k = 0; k < a.spring.size(); ++k) bad += !SameBits(a.spring[k], b.spring[k]) || a.touching[k] != b.touching[k];
+  EXPECT_EQ(bad, 0) << what << ": slots or contacts that differ from the scalar kernel";
+}
+
+// Random pairs of particles (each pair far from the others, so each branch of the law is met in
+// isolation), then a dense random cluster with a wide list cutoff (half lists of 30-50 partners:
+// several blocks per particle); random overlaps, velocities, plastic deformations, adhesions and
+// anchor springs. The branches are counted with the scalar law itself.
+TEST(PairKernel, VectorGivesTheScalarKernelsResultsBitForBitOnEveryBranch) {
+  SoilParams soil = Nominal();
+  const SoilContactLaw law(soil);
+  const double D = soil.diameter, d0 = law.d0, dt = 2e-5;
+  std::mt19937_64 rng(12345);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), u01(0.0, 1.0);
+  auto random_unit = [&] {
+    Vector3d n;
+    do n = Vector3d(u(rng), u(rng), u(rng));
+    while (n.norm() < 0.1 || n.norm() > 1.0);
+    return n.normalized();
+  };
+  ParticleStore ps;
+  bool appended = false;
+  const int pairs = 4000;
+  for (int p = 0; p < pairs; ++p) {
+    const Vector3d c(3.0 * D * (p % 20), 3.0 * D * ((p / 20) % 20), 3.0 * D * (p / 400));
+    const Vector3d n = random_unit();
+    // separations from a gap of 0.05 d to an overlap of 0.25 d (adhesion, repulsion, the skin)
+    const double overlap = D * (-0.05 + 0.3 * u01(rng));
+    const double dist = D - overlap;
+    const Vector3d v = 0.3 * Vector3d(u(rng), u(rng), u(rng));
+    ps.Add(c + 0.5 * dist * n, v, Vector3d::Zero(), 0.0, SlotState::kListed, &appended);
+    ps.Add(c - 0.5 * dist * n, -v, Vector3d::Zero(), 0.0, SlotState::kListed, &appended);
+  }
+  // the cluster: 500 particles in a cube, overlaps up to 0.3 d
+  const Vector3d corner(0.0, 0.0, 30.0 * D);
+  for (int i = 0; i < 500; ++i)
+    ps.Add(corner + 4.0 * D * Vector3d(u01(rng), u01(rng), u01(rng)), 0.5 * Vector3d(u(rng), u(rng), u(rng)),
+           Vector3d::Zero(), 0.0, SlotState::kListed, &appended);
+  NeighbourList lists(2.0 * D, 2);
+  lists.Build(&ps, 1);
+  for (int i = 0; i < ps.slots(); ++i) {
+    ps.plastic[i] = u01(rng) < 0.3 ? 0.0 : 0.06 * D * u01(rng);
+    ps.adhesion_max[i] = u01(rng) < 0.1 ? 0.0 : MaxAdhesionForce(soil, ps.plastic[i]) * (0.5 + u01(rng));
+  }
+  // anchor springs: small (stick) to far beyond the cap (slip); some contacts new (zero spring)
+  const double cap_scale = soil.friction * law.k_n * 0.05 * D / law.friction.k_t;
+  int longest = 0;
+  for (int i = 0; i < ps.slots(); ++i) {
+    longest = std::max(longest, lists.end(i) - lists.begin(i));
+    for (int k = lists.begin(i); k < lists.end(i); ++k) {
+      const double r = u01(rng);
+      lists.histories()[k].spring = r < 0.2 ? Vector3d::Zero() : Vector3d(Vector3d(u(rng), u(rng), u(rng)) * cap_scale * 3.0 * r);
+      lists.touching()[k] = u01(rng) < 0.5;
+    }
+  }
+  EXPECT_GT(longest, 2 * 16) << "some particle's half list spans several blocks";
+
+  // the branches, by the scalar law on each listed pair
+  int skin = 0, adhesion = 0, repulsion = 0, loading = 0, unloading = 0, stick = 0, slip = 0, no_cohesion = 0;
+  for (int i = 0; i < ps.slots(); ++i)
+    for (int k = lists.begin(i); k < lists.end(i); ++k) {
+      const int j = lists.partners()[k];
+      const Vector3d r = ps.x[i] - ps.x[j];
+      const double dist = r.norm(), d = D - dist - (ps.plastic[i] + ps.plastic[j]);
+      if (dist >= D) continue;
+      if (!(d > 0.0)) {
+        ++skin;
+        continue;
+      }
+      const Vector3d n = r / dist, vr = ps.v[i] - ps.v[j];
+      const double vn = vr.dot(n);
+      const double fmax = std::min(ps.adhesion_max[i], ps.adhesion_max[j]);
+      const SoilNormalForce fn = law.Normal(d, -vn, fmax);
+      (d < d0 ? adhesion : repulsion) += 1;
+      no_cohesion += fmax == 0.0;
+      (-vn > 0.0 ? loading : unloading) += 1;
+      TangentialHistory h = lists.histories()[k];
+      bool slipped = false;
+      Vector3d s = h.spring - h.spring.dot(n) * n;
+      s += (vr - vn * n) * dt;
+      law.friction.Force(vr - vn * n, fn.repulsion, &s, &slipped);
+      (slipped ? slip : stick) += 1;
+    }
+  std::printf("branches: in the skin %d, adhesion %d, repulsion %d, loading %d, unloading %d, stick %d, slip %d, "
+              "no adhesion %d\n", skin, adhesion, repulsion, loading, unloading, stick, slip, no_cohesion);
+  for (int c : {skin, adhesion, repulsion, loading, unloading, stick, slip, no_cohesion}) EXPECT_GT(c, 50);
+
+  const SweepOut ref = Sweep(law, D, dt, 1, ps, lists, PairKernel::kScalar);
+  // the outputs that drive the plastic relaxation: particles whose tension exceeds their repulsion
+  int relaxing = 0;
+  for (int i = 0; i < ps.slots(); ++i) relaxing += ref.max_tension[i] > ref.max_repulsion[i];
+  EXPECT_GT(relaxing, 50) << "particles that would relax (tension above repulsion)";
+  for (PairKernel kernel : VectorKernels())
+    for (int threads : {1, 2}) {
+      SCOPED_TRACE(PairKernelName(kernel));
+      ExpectSameBits(ref, Sweep(law, D, dt, threads, ps, lists, kernel), PairKernelName(kernel));
+    }
+  // without cohesion (the law's other instance)
+  soil.cohesion = false;
+  const SoilContactLaw plain(soil);
+  const SweepOut ref_plain = Sweep(plain, D, dt, 1, ps, lists, PairKernel::kScalar);
+  for (PairKernel kernel : VectorKernels()) ExpectSameBits(ref_plain, Sweep(plain, D, dt, 2, ps, lists, kernel), "no cohesion");
+}
+
+// A poured cohesive bed stepped on the scalar and on each vector kernel: the same states to the bit
+// after 300 steps (contacts made and broken, plasticity, walls).
+TEST(PairKernel, ADemRunOnTheVectorKernelIsTheScalarRunBitForBit) {
+  const SoilParams soil = Nominal();
+  const double D = soil.diameter;
+  auto run = [&](PairKernel kernel) {
+    DemSettings st;
+    st.threads = 2;
+    st.pair_kernel = kernel;
+    DemSystem s(soil, st);
+    for (DemWall& w : MakeOpenBoxWalls(12 * D, 12 * D, 30 * D)) s.AddWall(std::move(w));
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int k = 0; k < 20; ++k)
+      for (int j = 0; j < 11; ++j)
+        for (int i = 0; i < 11; ++i)
+          s.AddParticle(Vector3d((i + 0.7 + 0.1 * u(rng)) * D, (j + 0.7 + 0.1 * u(rng)) * D, (k + 0.6) * 0.93 * D),
+                        Vector3d(0.1 * (u(rng) - 0.5), 0.1 * (u(rng) - 0.5), -0.3));
+    s.Finalize(0.5 * s.CriticalTimeStep().dt_crit);
+    for (int i = 0; i < 300; ++i) s.Step();
+    return s;
+  };
+  const DemSystem ref = run(PairKernel::kScalar);
+  EXPECT_GT(ref.contacts(), 1000);
+  for (PairKernel kernel : VectorKernels()) {
+    const DemSystem s = run(kernel);
+    EXPECT_EQ(s.pair_kernel(), kernel);
+    int bad = 0;
+    for (int id = 0; id < ref.size(); ++id)
+      bad += !SameBits(ref.position(id), s.position(id)) || !SameBits(ref.velocity(id), s.velocity(id)) ||
+             !SameBits(ref.plastic_deformation(id), s.plastic_deformation(id));
+    EXPECT_EQ(bad, 0) << PairKernelName(kernel) << ": particles whose state differs from the scalar run";
+  }
+}
+
+TEST(PairKernel, AutoTakesTheBestInstanceTheCpuHas) {
+  const PairKernel k = ResolvePairKernel(PairKernel::kAuto);
+  EXPECT_NE(k, PairKernel::kAuto);
+  EXPECT_NE(k, PairKernel::kScalar);
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512bw")) {
+    EXPECT_EQ(k, PairKernel::kVectorAvx512);
+  } else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+    EXPECT_EQ(k, PairKernel::kVectorAvx2);
+  }
+  std::printf("this CPU: %s\n", PairKernelName(PairKernel::kAuto));
+}
+
+}  // namespace
+}  // namespace dem_mobility::core
