@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <string>
 
+#include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_mobility/core/scenes/dem_pour.h"
@@ -99,6 +100,13 @@ int main(int argc, char** argv) {
   const std::string file = argc > 1 ? argv[1] : DM_CONFIG_DIR "/soils/nominal_clay.yaml";
   const int steps = argc > 2 ? std::stoi(argv[2]) : 1000;
   const SoilParams soil = SoilParams::Read(YamlReader::Load(file));
+  // the ceiling: the law alone on blocks in L1, per instance (pairs per second, one thread)
+  for (PairKernel k : {PairKernel::kVectorAvx512, PairKernel::kVectorAvx2, PairKernel::kVectorBaseline}) try {
+      const double r = PairLawThroughput(k, SoilContactLaw(soil), soil.diameter, 1.5e-5, 2000000);
+      std::printf("dem_step law_only_%s %.1f Mpairs/s\n", PairKernelName(k), r * 1e-6);
+    } catch (const ConfigError&) {
+      std::printf("dem_step law_only_%d not on this CPU\n", static_cast<int>(k));
+    }
   const DemSystem bed_a = ReferenceBed(soil);
   std::printf("dem_step bed_particles %d count\n", bed_a.num_alive());
   std::printf("dem_step bed_contacts %d count\n", bed_a.contacts());

@@ -90,6 +90,18 @@ if [ "$want" = all ] || [ "$want" = dem_step ]; then
     echo "dem_step lammps_mean_normal_force $(awk '$1 == 1200 && NF == 3 {printf "%.4g", $3}' "$tmp/lmp2.log") N"
     ours=$(awk '/bed_rate_2threads/ {print $3}' "$tmp/dem.txt")
     echo "dem_step lammps_ratio_2threads $(python3 -c "print(round($ours / $l2, 3))") ratio"
+    # bed (b)'s granular counterpart (bench/lammps-poured-bed.in: the same count, size and box,
+    # settled at rest; gran/hooke/history at our k_n), 2 ranks: its timed run is the last 1000 steps
+    (cd "$tmp" && mpirun --allow-run-as-root --oversubscribe -np 2 lmp -in "$DM_ROOT/bench/lammps-poured-bed.in" >lmp3.log 2>&1)
+    p2=$(rate "$tmp/lmp3.log")
+    echo "dem_step lammps_poured_rate_2ranks $p2 Mparticle-steps/s"
+    echo "dem_step lammps_poured_rebuilds $(awk '/Neighbor list builds/ {n = $NF} END {print n}' "$tmp/lmp3.log") count (in 1000 timed steps)"
+    # the last thermo line of the timed run: step atoms ke coordination mean-normal-force
+    read -r _ _ _ p_cn p_mf < <(awk '$1 == 13500 && NF == 5' "$tmp/lmp3.log")
+    echo "dem_step lammps_poured_contacts_per_particle $p_cn count"
+    echo "dem_step lammps_poured_mean_normal_force $p_mf N"
+    poured=$(awk '/poured_rate_2threads/ {print $3}' "$tmp/dem.txt")
+    [ -n "$poured" ] && echo "dem_step lammps_poured_ratio_2threads $(python3 -c "print(round($poured / $p2, 3))") ratio"
   else
     echo "dem_step: $bed not found; LAMMPS not run" >&2
   fi

@@ -5,6 +5,7 @@
 #include "dem_mobility/core/dem/pair_sweep.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "dem_mobility/core/common/error.h"
@@ -125,7 +126,7 @@ struct alignas(64) Block {
   double sx[kBlock], sy[kBlock], sz[kBlock];     // the anchor spring: in, and out
   double fx[kBlock], fy[kBlock], fz[kBlock];     // the contact force on i
   double rep[kBlock], ten[kBlock], ovl[kBlock];  // repulsion, tension (-adhesion), overlap
-  double skin[kBlock], contact[kBlock];          // 1: within the diameter; 1: in contact (d > 0)
+  double contact[kBlock];                        // 1: in contact (d > 0)
 };
 
 // The law on lanes [0, n) of a block, n a multiple of kPad: the scalar law's operations in its
@@ -176,19 +177,24 @@ template <bool kCohesion>
     ftx = slip ? stx : ftx;
     fty = slip ? sty : fty;
     ftz = slip ? stz : ftz;
-    b->sx[l] = slip ? -(ftx - fcx) * c.inv_k_t : sx;
-    b->sy[l] = slip ? -(fty - fcy) * c.inv_k_t : sy;
-    b->sz[l] = slip ? -(ftz - fcz) * c.inv_k_t : sz;
+    sx = slip ? -(ftx - fcx) * c.inv_k_t : sx;
+    sy = slip ? -(fty - fcy) * c.inv_k_t : sy;
+    sz = slip ? -(ftz - fcz) * c.inv_k_t : sz;
     ftx -= c.c_visc * vtx;
     fty -= c.c_visc * vty;
     ftz -= c.c_visc * vtz;
-    b->fx[l] = total * nx + ftx;
-    b->fy[l] = total * ny + fty;
-    b->fz[l] = total * nz + ftz;
-    b->rep[l] = repulsion;
-    b->ten[l] = -adhesion;
-    b->ovl[l] = overlap;
-    b->skin[l] = skin ? 1.0 : 0.0;
+    // a lane without contact scatters nothing: zero force, spring and maxima (adding +0 changes no
+    // sum: a particle's sum starts at +0 and so is never -0), its overlap only where it is within
+    // the diameter; its spring is reset (it is zero already when the pair did not touch before)
+    b->sx[l] = contact ? sx : 0.0;
+    b->sy[l] = contact ? sy : 0.0;
+    b->sz[l] = contact ? sz : 0.0;
+    b->fx[l] = contact ? total * nx + ftx : 0.0;
+    b->fy[l] = contact ? total * ny + fty : 0.0;
+    b->fz[l] = contact ? total * nz + ftz : 0.0;
+    b->rep[l] = contact ? repulsion : 0.0;
+    b->ten[l] = contact ? -adhesion : 0.0;
+    b->ovl[l] = skin ? overlap : 0.0;
     b->contact[l] = contact ? 1.0 : 0.0;
   }
 }
@@ -227,21 +233,8 @@ template <bool kCohesion>
       b->sx[l] = b->sy[l] = b->sz[l] = 0.0;
     }
     BlockLaw<kCohesion>(c, n, b);
-    for (int l = 0; l < m; ++l) {
-      const int k = k0 + l;
-      if (b->contact[l] == 0.0) {
-        if (b->skin[l] != 0.0) {
-          max_overlap = std::max(max_overlap, b->ovl[l]);
-          double& oj = a.overlap[a.nbr[k]];
-          oj = std::max(oj, b->ovl[l]);
-        }
-        if (a.touching[k]) {
-          a.hist[k] = TangentialHistory();
-          a.touching[k] = 0;
-        }
-        continue;
-      }
-      const int j = a.nbr[k];
+    for (int l = 0; l < m; ++l) {  // no branch: a lane without contact adds zeros
+      const int k = k0 + l, j = a.nbr[k];
       max_overlap = std::max(max_overlap, b->ovl[l]);
       a.overlap[j] = std::max(a.overlap[j], b->ovl[l]);
       fi0 += b->fx[l];
@@ -256,7 +249,7 @@ template <bool kCohesion>
       a.max_repulsion[j] = std::max(a.max_repulsion[j], b->rep[l]);
       a.max_tension[j] = std::max(a.max_tension[j], b->ten[l]);
       a.hist[k].spring = Vector3d(b->sx[l], b->sy[l], b->sz[l]);
-      a.touching[k] = 1;
+      a.touching[k] = static_cast<unsigned char>(b->contact[l] != 0.0);
     }
   }
   Vector3d& f = a.f[i];
@@ -272,16 +265,44 @@ template <bool kCohesion>
 [[gnu::always_inline]] inline void SweepSlabBody(const LawConstants& c, const SweepArrays& a, const SlotState* state,
                                                  int begin, int end, const std::vector<int>& added) {
   Block b;
+  // the partners of the slot kAhead on are fetched into the cache while this one is computed: the
+  // slots of the next cell rows along the grid's slower axes lie a plane of cells further on, and
+  // the block's gather would wait for each of them (a quarter of the sweep's time without this)
+  constexpr int kAhead = 3;
+  auto prefetch = [&](int p) {
+    for (int k = a.nbr_begin[p]; k < a.nbr_end[p]; ++k) {
+      const int j = a.nbr[k];
+      __builtin_prefetch(&a.hot[j], 0, 3);
+      __builtin_prefetch(&a.f[j], 1, 3);
+    }
+  };
   if (c.cohesion) {
-    for (int i = begin; i < end; ++i)
+    for (int i = begin; i < end; ++i) {
+      if (i + kAhead < end) prefetch(i + kAhead);
       if (state[i] == SlotState::kListed) SweepParticle<true>(c, a, i, &b);
+    }
     for (const int i : added) SweepParticle<true>(c, a, i, &b);
   } else {
-    for (int i = begin; i < end; ++i)
+    for (int i = begin; i < end; ++i) {
+      if (i + kAhead < end) prefetch(i + kAhead);
       if (state[i] == SlotState::kListed) SweepParticle<false>(c, a, i, &b);
+    }
     for (const int i : added) SweepParticle<false>(c, a, i, &b);
   }
 }
+
+// The law alone on one block, `reps` times (PairLawThroughput): each evaluation feeds its springs to
+// the next, so that none is optimised away.
+[[gnu::always_inline]] inline void LawOnlyBody(const LawConstants& c, Block* b, long reps) {
+  for (long r = 0; r < reps; ++r) BlockLaw<true>(c, kBlock, b);
+}
+__attribute__((target("arch=x86-64-v4"))) void LawOnlyAvx512(const LawConstants& c, Block* b, long reps) {
+  LawOnlyBody(c, b, reps);
+}
+__attribute__((target("arch=x86-64-v3"))) void LawOnlyAvx2(const LawConstants& c, Block* b, long reps) {
+  LawOnlyBody(c, b, reps);
+}
+void LawOnlyBaseline(const LawConstants& c, Block* b, long reps) { LawOnlyBody(c, b, reps); }
 
 using SlabFunction = void (*)(const LawConstants&, const SweepArrays&, const SlotState*, int, int,
                               const std::vector<int>&);
@@ -313,6 +334,12 @@ bool CpuHasAvx2() {
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi2");
 }
 
+LawConstants ConstantsOf(const SoilContactLaw& law, double diameter, double dt) {
+  const AsperityFriction& fr = law.friction;
+  return LawConstants{diameter, diameter * diameter, dt,   law.k_n,  law.c_n, law.d0,   law.inv_dp,  law.inv_d0_dp,
+                      law.s_n,  fr.mu,                 fr.k_t, fr.inv_k_t, fr.v_slip, fr.c_visc, law.cohesion};
+}
+
 void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, double dt, int threads,
                  ParticleStore* ps, NeighbourList* lists) {
   const int n = ps->slots();
@@ -332,9 +359,7 @@ void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, 
     h.plastic = ps->plastic[i];
     h.adhesion_max = ps->adhesion_max[i];
   }
-  const AsperityFriction& fr = law.friction;
-  const LawConstants c{diameter, diameter * diameter, dt,   law.k_n,  law.c_n, law.d0,   law.inv_dp,  law.inv_d0_dp,
-                       law.s_n,  fr.mu,                 fr.k_t, fr.inv_k_t, fr.v_slip, fr.c_visc, law.cohesion};
+  const LawConstants c = ConstantsOf(law, diameter, dt);
   const SweepArrays a{hot,
                       ps->f.data(),
                       ps->max_repulsion.data(),
@@ -391,6 +416,35 @@ void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threa
     case PairKernel::kVectorBaseline: return SweepVector(SweepSlabBaseline, law, diameter, dt, threads, ps, lists);
     default: return SweepScalar(law, diameter, dt, threads, ps, lists);
   }
+}
+
+double PairLawThroughput(PairKernel kernel, const SoilContactLaw& law, double diameter, double dt, long repetitions) {
+  const LawConstants c = ConstantsOf(law, diameter, dt);
+  Block b;
+  for (int l = 0; l < kBlock; ++l) {  // pairs in contact about the repulsion onset, sliding and not
+    const double t = l / double(kBlock);
+    b.rx[l] = diameter * (0.94 + 0.02 * t);
+    b.ry[l] = 0.01 * diameter * t;
+    b.rz[l] = -0.02 * diameter * t;
+    b.vx[l] = 0.01 * (t - 0.5);
+    b.vy[l] = 0.02 * t;
+    b.vz[l] = -0.01;
+    b.psum[l] = 0.0;
+    b.amax[l] = 1.0;
+    b.sx[l] = b.sy[l] = b.sz[l] = 0.0;
+  }
+  void (*run)(const LawConstants&, Block*, long) = nullptr;
+  switch (ResolvePairKernel(kernel)) {
+    case PairKernel::kVectorAvx512: run = LawOnlyAvx512; break;
+    case PairKernel::kVectorAvx2: run = LawOnlyAvx2; break;
+    case PairKernel::kVectorBaseline: run = LawOnlyBaseline; break;
+    default: throw ConfigError("PairLawThroughput: the scalar kernel has no block law");
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  run(c, &b, repetitions);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  DM_THROW_UNLESS(std::isfinite(b.sx[kBlock - 1]), "PairLawThroughput: non-finite spring");
+  return static_cast<double>(repetitions) * kBlock / wall;
 }
 
 }  // namespace dem_mobility::core
