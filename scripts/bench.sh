@@ -97,7 +97,7 @@ if [ "$want" = all ] || [ "$want" = dem_step ]; then
     echo "dem_step lammps_poured_rate_2ranks $p2 Mparticle-steps/s"
     echo "dem_step lammps_poured_rebuilds $(awk '/Neighbor list builds/ {n = $NF} END {print n}' "$tmp/lmp3.log") count (in 1000 timed steps)"
     # the last thermo line of the timed run: step atoms ke coordination mean-normal-force
-    read -r _ _ _ p_cn p_mf < <(awk '$1 == 13500 && NF == 5' "$tmp/lmp3.log")
+    read -r _ _ _ p_cn p_mf < <(awk '$1 == 13500 && NF == 5' "$tmp/lmp3.log") || true
     echo "dem_step lammps_poured_contacts_per_particle $p_cn count"
     echo "dem_step lammps_poured_mean_normal_force $p_mf N"
     poured=$(awk '/poured_rate_2threads/ {print $3}' "$tmp/dem.txt")
