@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
@@ -69,6 +70,24 @@ Timed Rate(DemSystem s, int threads, int steps, PairKernel kernel = PairKernel::
   return Timed{static_cast<double>(s.num_alive()) * steps / wall, s.neighbour_builds() - builds0};
 }
 
+// The memory ceiling of the roofline: a STREAM-style triad a = b + s c over three arrays of 2^25
+// doubles (768 MB in all, far beyond the caches) on `threads` threads, best of 5, in GB/s (24 bytes
+// moved per element: two reads and a write; the write-allocate read not counted, as STREAM does).
+double TriadBandwidth(int threads) {
+  const long n = 1L << 25;
+  std::vector<double> a(n, 0.0), b(n, 1.0), c(n, 2.0);
+  double best = 0.0;
+  for (int rep = 0; rep < 5; ++rep) {
+    const auto t0 = std::chrono::steady_clock::now();
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long i = 0; i < n; ++i) a[i] = b[i] + 3.0 * c[i];
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    best = std::max(best, 24.0 * n / wall * 1e-9);
+  }
+  if (!(a[n / 2] == 7.0)) std::printf("dem_step triad: wrong result\n");
+  return best;
+}
+
 // The rates of the default (vector) kernel and of the scalar reference at 1 and 2 threads, the
 // rebuilds in the timed steps and the contacts at the end of the warm-up: the lines of one bed.
 void Report(const char* bed, const DemSystem& s, int steps) {
@@ -100,6 +119,8 @@ int main(int argc, char** argv) {
   const std::string file = argc > 1 ? argv[1] : DM_CONFIG_DIR "/soils/nominal_clay.yaml";
   const int steps = argc > 2 ? std::stoi(argv[2]) : 1000;
   const SoilParams soil = SoilParams::Read(YamlReader::Load(file));
+  std::printf("dem_step memory_triad_1thread %.1f GB/s\n", TriadBandwidth(1));
+  std::printf("dem_step memory_triad_2threads %.1f GB/s\n", TriadBandwidth(2));
   // the ceiling: the law alone on blocks in L1, per instance (pairs per second, one thread)
   for (PairKernel k : {PairKernel::kVectorAvx512, PairKernel::kVectorAvx2, PairKernel::kVectorBaseline}) try {
       const double r = PairLawThroughput(k, SoilContactLaw(soil), soil.diameter, 1.5e-5, 2000000);
