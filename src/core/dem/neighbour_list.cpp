@@ -1,6 +1,7 @@
 #include "dem_mobility/core/dem/neighbour_list.h"
 
 #include <cmath>
+#include <omp.h>
 
 namespace dem_mobility::core {
 
@@ -109,46 +110,64 @@ const TangentialHistory* NeighbourList::FindHistory(int i, int j) const {
 }
 
 void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
-  // each slot's partners within the cutoff in the pairs it owns (half list), ascending
+  // each slot's partners within the cutoff in the pairs it owns (half list), ascending. Each thread
+  // takes a contiguous range of slots and lists their partners one after the other in a buffer of
+  // its own (kept from build to build: no allocation per slot), then, once every slot's count is
+  // known, copies them to their place: the same lists for any thread count
   const int n = ps.slots();
   const double cut2 = cutoff_ * cutoff_;
   const int live = cell_start_.back();
   const std::vector<Vector3d>& x = ps.x;
-  std::vector<std::vector<int>> found(live);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int i = 0; i < live; ++i) {
-    std::vector<int>& out = found[i];
-    ForEachSlotNear(CellOf(x[i]), [&](int j) {
-      if (j != i && Owns(i, j) && (x[i] - x[j]).squaredNorm() < cut2) out.push_back(j);
-    });
-    std::sort(out.begin(), out.end());
-  }
-  // the lists in slot order, each with room for slack_ more
+  if (static_cast<int>(found_.size()) < threads) found_.resize(threads);
   std::vector<int> begin(n), end(n), cap(n);
-  int total = 0;
-  for (int i = 0; i < n; ++i) {
-    begin[i] = total;
-    end[i] = total + (i < live ? static_cast<int>(found[i].size()) : 0);
-    cap[i] = i < live ? end[i] + slack_ : end[i];
-    total = cap[i];
-  }
-  std::vector<int> nbr(total, -1);
-  std::vector<TangentialHistory> hist(total);
-  std::vector<unsigned char> touching(total, 0);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int i = 0; i < live; ++i) {
-    // carry each surviving contact's history over, from whichever side owned it before
-    for (int k = begin[i], m = 0; k < end[i]; ++k, ++m) {
-      const int j = found[i][m];
-      nbr[k] = j;
-      if (const TangentialHistory* h = FindHistory(i, j)) {
-        hist[k] = *h;
-        touching[k] = 1;
-      } else if (const TangentialHistory* g = FindHistory(j, i)) {
-        hist[k].spring = -g->spring;
-        touching[k] = 1;
-      }
+  std::vector<int> nbr;
+  std::vector<TangentialHistory> hist;
+  std::vector<unsigned char> touching;
+#pragma omp parallel num_threads(threads)
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    const int lo = static_cast<int>(static_cast<long>(live) * t / nt);
+    const int hi = static_cast<int>(static_cast<long>(live) * (t + 1) / nt);
+    std::vector<int>& out = found_[t];
+    out.clear();
+    for (int i = lo; i < hi; ++i) {
+      const size_t first = out.size();
+      ForEachSlotNear(CellOf(x[i]), [&](int j) {
+        if (j != i && Owns(i, j) && (x[i] - x[j]).squaredNorm() < cut2) out.push_back(j);
+      });
+      std::sort(out.begin() + static_cast<long>(first), out.end());
+      end[i] = static_cast<int>(out.size() - first);  // the count, for now
     }
+#pragma omp barrier
+#pragma omp single
+    {
+      // the lists in slot order, each with room for slack_ more
+      int total = 0;
+      for (int i = 0; i < n; ++i) {
+        const int count = i < live ? end[i] : 0;
+        begin[i] = total;
+        end[i] = total + count;
+        cap[i] = i < live ? end[i] + slack_ : end[i];
+        total = cap[i];
+      }
+      nbr.assign(total, -1);
+      hist.assign(total, TangentialHistory());
+      touching.assign(total, 0);
+    }
+    // carry each surviving contact's history over, from whichever side owned it before
+    size_t m = 0;
+    for (int i = lo; i < hi; ++i)
+      for (int k = begin[i]; k < end[i]; ++k, ++m) {
+        const int j = out[m];
+        nbr[k] = j;
+        if (const TangentialHistory* h = FindHistory(i, j)) {
+          hist[k] = *h;
+          touching[k] = 1;
+        } else if (const TangentialHistory* g = FindHistory(j, i)) {
+          hist[k].spring = -g->spring;
+          touching[k] = 1;
+        }
+      }
   }
   nbr_begin_.swap(begin);
   nbr_end_.swap(end);
@@ -269,6 +288,7 @@ size_t NeighbourList::MemoryBytes() const {
   size_t b = bytes(nbr_begin_) + bytes(nbr_end_) + bytes(nbr_cap_) + bytes(nbr_) + bytes(hist_) + bytes(touching_) +
              bytes(cell_start_) + bytes(added_since_build_) + bytes(slab_of_) + bytes(slab_start_);
   for (const auto& a : slab_added_) b += bytes(a);
+  for (const auto& a : found_) b += bytes(a);
   return b;
 }
 

@@ -102,6 +102,7 @@ class NeighbourList {
   int slab_axis_ = 0, cells_per_slab_ = 1;
   std::vector<int> slab_of_, slab_start_;
   std::vector<std::vector<int>> slab_added_;
+  std::vector<std::vector<int>> found_;  ///< a build's partners, per thread (kept: no allocation per slot)
 };
 
 }  // namespace dem_mobility::core
