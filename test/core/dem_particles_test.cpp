@@ -100,6 +100,7 @@ DemSystem Stream(int threads, long* adds) {
   const double D = p.diameter, L = 8 * D;
   DemSettings st;
   st.threads = threads;
+  st.serial_below = 0;  // 100 particles: on `threads` all the same, to test them
   DemSystem s(p, st);
   for (DemWall& w : MakeOpenBoxWalls(L, L, L)) s.AddWall(std::move(w));
   // 25 emission points, each used every 1000 steps, high above the columns that pile up below them

@@ -23,6 +23,7 @@ DemSystem::DemSystem(const SoilParams& soil, const DemSettings& settings)
   DM_THROW_UNLESS(settings.max_overlap > 0.0 && settings.max_overlap < 1.0, "DEM max_overlap ",
                   settings.max_overlap, " must lie in (0, 1)");
   DM_THROW_UNLESS(settings.list_slack >= 0, "DEM list_slack ", settings.list_slack, " must be >= 0");
+  DM_THROW_UNLESS(settings.serial_below >= 0, "DEM serial_below ", settings.serial_below, " must be >= 0");
   settings_.pair_kernel = ResolvePairKernel(settings.pair_kernel);
   mass_ = soil.Mass();
   cutoff_ = soil.diameter * (1.0 + settings.skin);
@@ -143,9 +144,9 @@ void DemSystem::set_gravity(const Vector3d& g) {
 }
 
 void DemSystem::Rebuild() {
-  const std::vector<int> order = lists_.Build(&ps_, settings_.threads);
+  const std::vector<int> order = lists_.Build(&ps_, Threads());
   walls_.PermuteSlots(order);
-  walls_.Build(ps_, settings_.threads, 0.0);
+  walls_.Build(ps_, Threads(), 0.0);
   rebuild_ = false;
   ++builds_;
 }
@@ -153,7 +154,7 @@ void DemSystem::Rebuild() {
 void DemSystem::ComputeForces() {
   const int n = ps_.slots();
   const Vector3d weight = mass_ * gravity_;
-  const int T = settings_.threads;
+  const int T = Threads();
 #pragma omp parallel for schedule(static) num_threads(T)
   for (int i = 0; i < n; ++i) {
     ps_.f[i] = ps_.live(i) ? weight : Vector3d::Zero();
@@ -173,7 +174,7 @@ void DemSystem::Step() {
   const std::vector<Vector3d>& f = ps_.f;
   double max_disp2 = 0.0;
   int tripped = n;  // the lowest slot a watchdog trips on
-#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(max : max_disp2) reduction(min : tripped)
+#pragma omp parallel for schedule(static) num_threads(Threads()) reduction(max : max_disp2) reduction(min : tripped)
   for (int i = 0; i < n; ++i) {
     if (!ps_.live(i)) continue;
     if (!ps_.held[i]) {
@@ -190,16 +191,16 @@ void DemSystem::Step() {
   if (rebuild_ || max_disp2 > half_skin * half_skin || walls_.MaxWallDisplacement(false) > half_skin)
     Rebuild();  // the particles or a slow wall moved half the skin
   else if (walls_.NeedsBuild(std::sqrt(max_disp2)))  // a fast wall moved: only the wall candidates
-    walls_.Build(ps_, settings_.threads, std::sqrt(max_disp2));
+    walls_.Build(ps_, Threads(), std::sqrt(max_disp2));
   const double power_before = ledger_.wall_power;
   ComputeForces();
   ledger_.wall_work += h * (power_before + ledger_.wall_power);  // trapezoidal
   const double overlap_limit = settings_.max_overlap * soil_.diameter;
-#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(min : tripped)
+#pragma omp parallel for schedule(static) num_threads(Threads()) reduction(min : tripped)
   for (int i = 0; i < n; ++i)
     if (ps_.live(i) && OverlapTrips(ps_, i, overlap_limit)) tripped = std::min(tripped, i);
   if (tripped < n) ReportOverlapTrip(ps_, tripped, soil_.diameter, settings_.max_overlap, step_, time_);
-#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+#pragma omp parallel for schedule(static) num_threads(Threads())
   for (int i = 0; i < n; ++i) {
     if (!ps_.live(i)) continue;
     if (!ps_.held[i]) v[i] += h * inv_m * f[i];

@@ -215,6 +215,13 @@ void WallContacts::Build(const ParticleStore& ps, int threads, double particle_d
   }
   tri_start_.assign(n + 1, 0);
   for (int i = 0; i < n; ++i) tri_start_[i + 1] = tri_start_[i] + count_[i];
+  // a listed slot with no triangle near keeps no wall contact until the next build: its histories
+  // are cleared here, once, and Compute passes it by (before, it cleared them at every step); a
+  // slot added since the neighbour build finds its triangles itself at every step (ComputeSlot)
+  const int W = size();
+  for (int i = 0; i < n; ++i)
+    if (count_[i] == 0 && ps.state[i] != SlotState::kAdded)
+      for (int w = 0; w < W; ++w) ClearHistory(static_cast<size_t>(i) * W + w);
   tri_of_slot_.resize(tri_start_[n]);
   if (T > 0)
     for (int c = 0; c < chunks; ++c)
@@ -341,7 +348,8 @@ double WallContacts::Compute(ParticleStore* ps, double dt, int threads) {
   for (int c = 0; c < chunks; ++c) {
     WallSum* sum = &chunk_[static_cast<size_t>(c) * W];
     for (int i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i)
-      if (ps->live(i)) ComputeSlot(ps, i, dt, sum);
+      if (ps->live(i) && (ps->state[i] == SlotState::kAdded || tri_start_[i + 1] > tri_start_[i]))
+        ComputeSlot(ps, i, dt, sum);
   }
   return SumWrenches(chunks);
 }

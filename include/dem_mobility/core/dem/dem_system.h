@@ -53,6 +53,9 @@ struct DemSettings {
   bool wall_bins = true;        ///< bin large walls' triangles (false: scan them all; same results)
   /// the pair kernel (pair_sweep.h): every choice gives the same results, bit for bit
   PairKernel pair_kernel = PairKernel::kAuto;
+  /// below this many particle slots every pass runs on one thread: a parallel region's start and
+  /// barriers cost more than such a pass (0: always on `threads`; the results are the same either way)
+  int serial_below = 512;
 };
 
 class DemSystem {
@@ -148,6 +151,8 @@ class DemSystem {
  private:
   void Rebuild();
   void ComputeForces();
+  /// The threads a pass runs on (settings_.serial_below).
+  int Threads() const { return ps_.slots() < settings_.serial_below ? 1 : settings_.threads; }
   DemEnergyTerms EnergyTerms() const { return DemEnergyTerms{&law_, soil_.diameter, mass_, gravity_}; }
 
   SoilParams soil_;
