@@ -261,34 +261,33 @@ template <bool kCohesion>
   a.overlap[i] = max_overlap;
 }
 
-// One slab: its listed slots in ascending order, then those added since the build.
+// One slab: its listed slots in ascending order, then those added since the build. The partners
+// of the slot kAhead on are fetched into the cache while this one is computed: the slots of the
+// next cell rows along the grid's slower axes lie a plane of cells further on, and the block's
+// gather would wait for each of them (a quarter of the sweep's time without this).
+template <bool kCohesion>
+[[gnu::always_inline]] inline void SweepSlabOf(const LawConstants& c, const SweepArrays& a, const SlotState* state,
+                                               int begin, int end, const std::vector<int>& added) {
+  constexpr int kAhead = 3;
+  Block b;
+  for (int i = begin; i < end; ++i) {
+    if (i + kAhead < end)
+      for (int k = a.nbr_begin[i + kAhead]; k < a.nbr_end[i + kAhead]; ++k) {
+        const int j = a.nbr[k];
+        __builtin_prefetch(&a.hot[j], 0, 3);
+        __builtin_prefetch(&a.f[j], 1, 3);
+      }
+    if (state[i] == SlotState::kListed) SweepParticle<kCohesion>(c, a, i, &b);
+  }
+  for (const int i : added) SweepParticle<kCohesion>(c, a, i, &b);
+}
+
 [[gnu::always_inline]] inline void SweepSlabBody(const LawConstants& c, const SweepArrays& a, const SlotState* state,
                                                  int begin, int end, const std::vector<int>& added) {
-  Block b;
-  // the partners of the slot kAhead on are fetched into the cache while this one is computed: the
-  // slots of the next cell rows along the grid's slower axes lie a plane of cells further on, and
-  // the block's gather would wait for each of them (a quarter of the sweep's time without this)
-  constexpr int kAhead = 3;
-  auto prefetch = [&](int p) {
-    for (int k = a.nbr_begin[p]; k < a.nbr_end[p]; ++k) {
-      const int j = a.nbr[k];
-      __builtin_prefetch(&a.hot[j], 0, 3);
-      __builtin_prefetch(&a.f[j], 1, 3);
-    }
-  };
-  if (c.cohesion) {
-    for (int i = begin; i < end; ++i) {
-      if (i + kAhead < end) prefetch(i + kAhead);
-      if (state[i] == SlotState::kListed) SweepParticle<true>(c, a, i, &b);
-    }
-    for (const int i : added) SweepParticle<true>(c, a, i, &b);
-  } else {
-    for (int i = begin; i < end; ++i) {
-      if (i + kAhead < end) prefetch(i + kAhead);
-      if (state[i] == SlotState::kListed) SweepParticle<false>(c, a, i, &b);
-    }
-    for (const int i : added) SweepParticle<false>(c, a, i, &b);
-  }
+  if (c.cohesion)
+    SweepSlabOf<true>(c, a, state, begin, end, added);
+  else
+    SweepSlabOf<false>(c, a, state, begin, end, added);
 }
 
 // The law alone on one block, `reps` times (PairLawThroughput): each evaluation feeds its springs to
