@@ -224,6 +224,35 @@ class TerrainNodelet : public nodelet::Nodelet {
           box.points.push_back(MakePoint(xs[a], ys[b], zs[1]));
         }
       arr->markers.push_back(box);
+      if (!d.strips.empty()) {
+        // soil only under the wheel tracks: each strip's walls, and the rigid floor between and
+        // beside the strips (its outline at its height)
+        auto strips = Marker("patch_strips", visualization_msgs::Marker::LINE_LIST, 1.0f, 1.0f, 1.0f, 0.5f);
+        strips.scale.x = 0.02;
+        for (const auto& b : d.strips)
+          for (double y : {b.first, b.second})
+            for (double z : {z0, z1}) {
+              strips.points.push_back(MakePoint(xs[0], y, z));
+              strips.points.push_back(MakePoint(xs[1], y, z));
+              if (z == z0)
+                for (double x : xs) {
+                  strips.points.push_back(MakePoint(x, y, z0));
+                  strips.points.push_back(MakePoint(x, y, z1));
+                }
+            }
+        std::vector<double> edges = {y0};
+        for (const auto& b : d.strips) {
+          edges.push_back(b.first);
+          edges.push_back(b.second);
+        }
+        edges.push_back(y1);
+        for (size_t i = 0; i + 1 < edges.size(); i += 2)
+          for (double y : {edges[i], edges[i + 1]}) {
+            strips.points.push_back(MakePoint(xs[0], y, d.strip_floor_z));
+            strips.points.push_back(MakePoint(xs[1], y, d.strip_floor_z));
+          }
+        arr->markers.push_back(strips);
+      }
       // the emitter's zone: the layer being filled, floor to the prepared surface
       auto emitter = Marker("patch_emitter", visualization_msgs::Marker::CUBE, 1.0f, 0.55f, 0.0f, 0.45f);
       const double ztop = surface_z_;

@@ -50,6 +50,11 @@ DemSoilParams TinySoil(double ci, double length = 0.0) {
   else
     text = std::regex_replace(text, std::regex("\ncone_index:[^\n]*"), "\ncone_index: " + std::to_string(ci));
   if (length > 0.0) {
+    // a short box lays its soil nearer the front wheels: the checks look nearer too
+    // (MakeDemSoilTerrain refuses a box whose laid soil does not reach the window)
+    const size_t cw = text.find("\n  check_window: [0.6, 1.4]");
+    if (cw == std::string::npos) throw std::runtime_error("soil_patch.yaml: patch.check_window [0.6, 1.4] not found");
+    text.replace(cw, std::string("\n  check_window: [0.6, 1.4]").size(), "\n  check_window: [0.3, 0.7]");
     // levels.tiny.length: the first `length:` after `  tiny:`
     const size_t tiny = text.find("\n  tiny:\n");
     const size_t at = tiny == std::string::npos ? tiny : text.find("    length: ", tiny);
@@ -429,6 +434,85 @@ TEST(VehicleOnSoil, MoreGradeGivesLessSpeedAndMoreConeIndexMore) {
   for (int g = 0; g < 2; ++g) EXPECT_GT(v[g][1], v[g][0]) << "grade " << grades[g];
 }
 
+// Soil only under the wheel tracks (track_strip_width, an option a scene may take when it needs no
+// soil between the tracks): two strips 0.9 m wide centred under the wheels, each between walls of
+// its own, a rigid floor between and beside them.
+TEST(TrackStrips, PoursSoilUnderTheTracksOnlyCarriesTheVehicleAndReEmitsIt) {
+  const TerrainVehicle vehicle = TerrainVehicleOf(Hmmwv());
+  const double w = 0.9, c = 0.5 * vehicle.track;
+  std::unique_ptr<TerrainModel> m = LoadTerrainModel(
+      kTerrain, vehicle, {"fidelity=tiny", "threads=1", "cone_index=100", "track_strip_width=0.9"});
+  auto* t = dynamic_cast<DemSoilTerrain*>(m.get());
+  ASSERT_NE(t, nullptr);
+  const DemSoilParams& p = t->bin().params();
+  const double d = p.level.particle_diameter;
+  // the poured count: the solid fraction of the strips' poured volume (consolidated depth over the
+  // consolidation), in particles of diameter d
+  const double poured = 0.58 * p.level.length * 2.0 * w * (0.4 / 0.85) / (M_PI / 6.0 * d * d * d);
+  const int n0 = t->bin().dem().num_alive();
+  EXPECT_NEAR(n0, poured, 1.0);
+  // every particle of the prepared bed lies in a strip (its centre at least a third of a
+  // diameter inside the strip's walls)
+  auto outside = [&]() {
+    int n = 0;
+    t->bin().dem().ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
+      if (std::abs(std::abs(x.y()) - c) > 0.5 * w - d / 3.0) ++n;
+    });
+    return n;
+  };
+  EXPECT_EQ(outside(), 0);
+  const SoilPatch& patch = *t->patch();
+  const double depth = patch.initial_surface() - patch.floor_z();
+  std::printf("track strips %.2f m at y = +-%.3f m: %d particles (%.0f over the whole width), soil %.3f m deep\n", w, c,
+              n0, poured * p.level.width / (2.0 * w), depth);
+  EXPECT_NEAR(depth, 0.4, 0.04);  // the depth the count is chosen for, within 10 %
+
+  // the vehicle braked on the strips for 1.2 s carries its weight on them, within 2 %
+  {
+    struct Watch final : public CoSimObserver {
+      double fz = 0.0;
+      long n = 0;
+      void OnStep(const VehicleCoSim& sim, const DriverCommand&) override {
+        if (sim.time() < 0.9 || sim.time() >= 1.2) return;
+        for (int i = 0; i < kWheels; ++i) fz += sim.wheel_wrenches()[i].force.z();
+        ++n;
+      }
+    } watch;
+    MobilityRun run(SoilScene(0.0, {"settle_time=1.2", "duration=0.01"}), std::make_unique<DemSoilTerrain>(*t));
+    const MobilityRunResult r = run.Run(&watch);
+    ASSERT_TRUE(r.error.empty()) << r.error;
+    const double weight = run.vehicle().system().TotalMass() * 9.81;
+    ASSERT_GT(watch.n, 0);
+    std::printf("weight %.0f N, the wheels on the strips carry %.0f N\n", weight, watch.fz / watch.n);
+    EXPECT_NEAR(watch.fz / watch.n, weight, 0.02 * weight);
+  }
+
+  // the wheels 0.5 m above the soil at 8 m/s to 6 m past where the patch starts to follow: the
+  // count never changes, the re-emitted soil lies in the strips and has the bed's density and
+  // surface within 5 %
+  const double h = t->description().time_step, r = t->bin().tire().radius;
+  const double x_end = patch.sphere_centre().x() + 6.0;
+  std::vector<WheelWrench> wr;
+  double x = 0.0;
+  for (long k = 0; x < x_end; ++k) {
+    t->Synchronize(k, k * h, Wheels(x, 1.0, 8.0, r));
+    t->GetWrenches(&wr);
+    t->Advance(h);
+    ASSERT_EQ(t->bin().dem().num_alive(), n0);
+    x += 8.0 * h;
+  }
+  const PatchStats& s = patch.stats();
+  std::printf("re-emitted %ld (strays %ld), %d checks: density ratio %.4f (%.4f-%.4f), surface offset %.4f m\n",
+              s.reemitted, s.strays, s.checks, s.density_ratio_mean, s.density_ratio_min, s.density_ratio_max,
+              s.surface_offset_mean);
+  EXPECT_TRUE(s.following);
+  EXPECT_GT(s.reemitted, 2000);
+  EXPECT_EQ(outside(), 0);
+  ASSERT_GE(s.checks, 5);
+  EXPECT_NEAR(s.density_ratio_mean, 1.0, 0.05);
+  EXPECT_LT(std::abs(s.surface_offset_mean), 0.05 * depth);
+}
+
 TEST(VehicleOnSoil, RefusesBadInputNamingFileAndKey) {
   // a cone index outside the level's table
   try {
@@ -445,6 +529,24 @@ TEST(VehicleOnSoil, RefusesBadInputNamingFileAndKey) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("levels.coarse.width"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("soil_patch.yaml"), std::string::npos) << e.what();
+  }
+  // a box too short for the soil the emitter lays to reach the check window ahead of the front
+  // wheels (the vehicle's tests take a 6 m box with a shorter window, [0.3, 0.7] m)
+  try {
+    LoadTerrainModel(kTerrain, TerrainVehicleOf(Hmmwv()), {"fidelity=tiny", "levels.tiny.length=6"});
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("soil_patch.yaml: levels.tiny.length"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("check_window"), std::string::npos) << e.what();
+  }
+  // track strips that do not fit the bin, or narrower than a tire
+  for (const char* strips : {"track_strip_width=2.0", "track_strip_width=0.3"}) {
+    try {
+      LoadTerrainModel(kTerrain, TerrainVehicleOf(Hmmwv()), {"fidelity=tiny", strips});
+      FAIL() << "no error for " << strips;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("soil_patch.yaml: track_strip_width"), std::string::npos) << e.what();
+    }
   }
   // an exchange step that is no whole number of the terrain's steps (a terrain with a step of
   // its own: a weightless one here, the check is the vehicle's)

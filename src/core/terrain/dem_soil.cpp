@@ -105,6 +105,11 @@ DemSoilParams DemSoilParams::Read(const YamlReader& y) {
     p.wall_margin = t.DoubleIn("margin", 0.0, 1.0, 0.0);
     t.Finish();
   }
+  if (y.Has("track_strip_width")) {
+    p.strip_width = y.DoubleIn("track_strip_width", 0.0, 100.0);
+    if (p.strip_width > 0.0 && !y.Has("patch"))
+      y.Fail("track_strip_width", "soil only under the wheel tracks is an option of the vehicle's moving patch (no patch: here)");
+  }
   if (y.Has("patch")) {
     p.patch = SoilPatchParams::Read(y.Child("patch"));
     const double h = p.patch.leveling_ahead + p.patch.leveling_radius;
@@ -115,10 +120,18 @@ DemSoilParams DemSoilParams::Read(const YamlReader& y) {
   return p;
 }
 
+std::vector<std::pair<double, double>> DemSoilParams::SoilBands() const {
+  if (strip_width <= 0.0) return {{-0.5 * level.width, 0.5 * level.width}};
+  const double h = 0.5 * strip_width;
+  return {{-strip_offset - h, -strip_offset + h}, {strip_offset - h, strip_offset + h}};
+}
+
+double DemSoilParams::SoilWidth() const { return strip_width > 0.0 ? 2.0 * strip_width : level.width; }
+
 int DemSoilParams::ParticleCount() const {
   const double d = level.particle_diameter;
   const double poured = level.soil_depth / consolidation;
-  return static_cast<int>(std::lround(solid_fraction * level.length * level.width * poured / (M_PI / 6.0 * d * d * d)));
+  return static_cast<int>(std::lround(solid_fraction * level.length * SoilWidth() * poured / (M_PI / 6.0 * d * d * d)));
 }
 
 double DemSoilParams::ConeIndex() const {
@@ -163,10 +176,43 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
   dem_ = std::make_unique<DemSystem>(p.soil, st);
   DemSystem& s = *dem_;
   const Vector3d o = p.origin - Vector3d(0.0, 0.5 * l.width, 0.0);
-  const std::vector<Vector3d> lattice = PourLattice(
-      p.ParticleCount(), d, 1.1, {0.0, 0.0}, {l.length, l.width},
-      [&](double x, double y) { return x >= 0.6 * d && x <= l.length - 0.6 * d && y >= 0.6 * d && y <= l.width - 0.6 * d; },
-      p.seed, /*spread_last_layer=*/p.patch.enabled);  // a vehicle's patch: level across its width
+  // the soil's bands across y (the whole width, or a strip under each wheel track), in the bin's
+  // frame (y from its side wall y0)
+  std::vector<std::pair<double, double>> bands = p.SoilBands();
+  for (auto& b : bands) {
+    b.first += 0.5 * l.width;
+    b.second += 0.5 * l.width;
+  }
+  if (p.strip_width > 0.0) {
+    DM_THROW_UNLESS(p.strip_offset > 0.0, "dem_soil: track strips need the vehicle's track (strip_offset)");
+    if (tire.width + 2.0 * d > p.strip_width)
+      throw ConfigError(detail::Concat(p.file, ": track_strip_width: the strips (", p.strip_width, " m) are narrower than the tire (",
+                                       tire.width, " m) plus two particle diameters"));
+    if (bands[0].first < 0.0 || bands[1].second > l.width || bands[1].first - bands[0].second < 2.0 * d)
+      throw ConfigError(detail::Concat(p.file, ": track_strip_width: two strips ", p.strip_width, " m wide centred ",
+                                       p.strip_offset, " m either side of the centre line (half the vehicle's track) must lie within the bin (levels.",
+                                       l.name, ".width ", l.width, " m) and leave two particle diameters (", 2.0 * d,
+                                       " m) between them"));
+  }
+  std::vector<Vector3d> lattice;
+  if (bands.size() == 1) {
+    lattice = PourLattice(
+        p.ParticleCount(), d, 1.1, {0.0, 0.0}, {l.length, l.width},
+        [&](double x, double y) { return x >= 0.6 * d && x <= l.length - 0.6 * d && y >= 0.6 * d && y <= l.width - 0.6 * d; },
+        p.seed, /*spread_last_layer=*/p.patch.enabled);  // a vehicle's patch: level across its width
+  } else {
+    // each strip poured between its own walls, its lattice centred between them, half the soil
+    const int count = p.ParticleCount();
+    for (size_t k = 0; k < bands.size(); ++k) {
+      const double y0 = bands[k].first, y1 = bands[k].second;
+      const int n = k == 0 ? count / 2 : count - count / 2;
+      const std::vector<Vector3d> strip = PourLattice(
+          n, d, 1.1, {0.0, y0}, {l.length, y1},
+          [&](double x, double y) { return x >= 0.6 * d && x <= l.length - 0.6 * d && y >= y0 + 0.6 * d && y <= y1 - 0.6 * d; },
+          p.seed + 7919u * static_cast<unsigned>(k), /*spread_last_layer=*/true);
+      lattice.insert(lattice.end(), strip.begin(), strip.end());
+    }
+  }
   double top = 0.0;
   for (const Vector3d& x : lattice) top = std::max(top, x.z());
   wall_height_ = top + 2.0 * d;
@@ -174,6 +220,23 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
   const double reach = p.patch.enabled ? l.length + p.patch.travel : l.length;
   std::vector<DemWall> box = MakeOpenBoxWalls(reach, l.width, wall_height_);
   box[2] = MakeQuadWall("x1", {l.length, 0, 0}, {0, l.width, 0}, {0, 0, wall_height_});
+  if (bands.size() > 1) {
+    // each strip between walls of its own (from the floor to the box's height), and a rigid floor
+    // at the bed's nominal depth over the rest of the width: between the strips and beside them
+    std::vector<double> edges = {0.0};
+    for (const auto& b : bands) {
+      // (none where a strip's side is the box's: two walls there would press the soil twice)
+      if (b.first > 1e-9) box.push_back(MakeQuadWall("strip_side", {0, b.first, 0}, {reach, 0, 0}, {0, 0, wall_height_}));
+      if (b.second < l.width - 1e-9)
+        box.push_back(MakeQuadWall("strip_side", {0, b.second, 0}, {reach, 0, 0}, {0, 0, wall_height_}));
+      edges.push_back(b.first);
+      edges.push_back(b.second);
+    }
+    edges.push_back(l.width);
+    for (size_t k = 0; k + 1 < edges.size(); k += 2)
+      if (edges[k + 1] - edges[k] > 1e-9)
+        box.push_back(MakeQuadWall("track_gap_floor", {0, edges[k], l.soil_depth}, {reach, 0, 0}, {0, edges[k + 1] - edges[k], 0}));
+  }
   for (DemWall& w : box) {
     for (Vector3d& v : w.mesh.vertices) v += o;
     container_.push_back(s.AddWall(std::move(w)));
@@ -214,7 +277,7 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
   }
   for (const Vector3d& x : lattice) s.AddParticle(o + x);
   s.Finalize(l.time_step);
-  prep_ = std::make_unique<SoilPreparation>(&s, lid_, l.length * l.width, o.z() + wall_height_ + 1.0, p.prep,
+  prep_ = std::make_unique<SoilPreparation>(&s, lid_, l.length * p.SoilWidth(), o.z() + wall_height_ + 1.0, p.prep,
                                             "dem_soil bin (" + p.file + ")");
 }
 
@@ -347,6 +410,11 @@ TerrainDisplay DemSoilTerrain::Display() const {
   d.box_height = bin_->wall_height();
   d.emitter_from = patch_->emitter_from();
   d.emitter_to = patch_->emitter_to();
+  const DemSoilParams& p = bin_->params();
+  if (p.strip_width > 0.0) {
+    for (const auto& b : p.SoilBands()) d.strips.emplace_back(p.origin.y() + b.first, p.origin.y() + b.second);
+    d.strip_floor_z = bin_->floor_z() + p.level.soil_depth;
+  }
   return d;
 }
 
@@ -378,6 +446,8 @@ void DemSoilTerrain::Describe(ResultFile* r) const {
   if (!patch_) return;
   const PatchStats& s = patch_->stats();
   r->Set("patch_following", s.following);
+  // 0: soil over the box's width; else the strips' width (soil only under the wheel tracks)
+  r->Set("patch_track_strip_width", p.strip_width);
   r->Set("patch_travel", patch_->sphere_centre().x() - bin_->params().origin.x() - 0.5 * p.level.length);
   r->Set("patch_reemitted", s.reemitted);
   r->Set("patch_strays", s.strays);
@@ -455,13 +525,41 @@ std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const Terr
   const DemSoilParams p = DemSoilParams::Read(y);
   y.String("model");
   y.Finish();
+  DemSoilParams q = p;
   const SoilBinLevel& l = p.level;
+  if (p.strip_width > 0.0) {
+    if (vehicle.wheels < 2 || !(vehicle.track > 0.0))
+      throw ConfigError(detail::Concat(p.file, ": track_strip_width: soil under the wheel tracks needs a vehicle with a track (this one has ",
+                                       vehicle.wheels, " wheels, track ", vehicle.track, " m)"));
+    q.strip_offset = 0.5 * vehicle.track;
+  }
   const double needed = vehicle.track + vehicle.tire.width + 2.0 * l.particle_diameter;
   if (vehicle.wheels > 1 && vehicle.track > 0.0 && needed > l.width)
     throw ConfigError(detail::Concat(p.file, ": levels.", l.name, ".width: the soil (", l.width,
                                      " m wide) is narrower than the vehicle's track (", vehicle.track,
                                      " m) plus a tire width and two particle diameters (", needed, " m)"));
-  return std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels);
+  if (p.patch.enabled && vehicle.wheelbase > 0.0) {
+    // The emitter lays ahead only what leaves the sphere's rear half, and the sphere (holding the
+    // whole box) reaches past the box's rear by its radius less half the box's length: the soil
+    // laid ahead trails the sphere's front by that much. When the patch starts to follow, the
+    // front wheels stand half the wheelbase ahead of the box's middle, so the laid soil stands
+    // ahead of them by half the box less that lag and half the wheelbase. The patch's checks look
+    // at the window check_window ahead of the front wheels, the soil they meet: it must be laid.
+    const double d = l.particle_diameter, half_w = 0.5 * l.width, mid = 0.5 * l.soil_depth + d;
+    const auto ahead = [&](double length) {
+      const double radius = std::sqrt(0.25 * length * length + half_w * half_w + mid * mid) + p.patch.sphere_margin;
+      return 0.5 * length - (radius - 0.5 * length) - 0.5 * vehicle.wheelbase;
+    };
+    if (ahead(l.length) < p.patch.check_to) {
+      double shortest = l.length;
+      while (ahead(shortest) < p.patch.check_to) shortest += 0.1;
+      throw ConfigError(detail::Concat(p.file, ": levels.", l.name, ".length: a box ", l.length, " m long lays its soil only ",
+                                       ahead(l.length), " m ahead of the front wheels (wheelbase ", vehicle.wheelbase,
+                                       " m), short of the end of patch.check_window (", p.patch.check_to,
+                                       " m): the wheels would meet soil not yet laid; at least ", shortest, " m"));
+    }
+  }
+  return std::make_unique<DemSoilTerrain>(q, vehicle.tire, vehicle.wheels);
 }
 
 TerrainDescription DescribeDemSoilTerrain(const YamlReader& y) {

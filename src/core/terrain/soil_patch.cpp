@@ -60,6 +60,10 @@ SoilPatch::SoilPatch(DemSoilBin* bin, const SoilPatchParams& p, unsigned seed)
   const double rear = bp.origin.x();
   front_x0_ = rear + bed_length_;
   n0_ = dem.size();
+  for (const auto& b : bp.SoilBands()) {
+    bands_.emplace_back(b.first + 1.5 * d_, b.second - 1.5 * d_);
+    band_width_ += bands_.back().second - bands_.back().first;
+  }
   // the bed's surface and depth, away from the end walls
   depth0_ = 1.0;  // (Measure's density layer needs a depth; the surface does not)
   const PatchSoilMeasure bed = Measure(rear + std::min(0.5, 0.1 * bed_length_), front_x0_ - std::min(0.5, 0.1 * bed_length_));
@@ -138,7 +142,7 @@ double SoilPatch::emitter_to() const { return layer_ < 0 ? front_x0_ : emitter_f
 PatchSoilMeasure SoilPatch::Measure(double x0, double x1) const {
   PatchSoilMeasure m;
   const DemSystem& dem = bin_->dem();
-  const double ymax = 0.5 * width_ - 1.5 * d_, cell = 2.0 * d_;
+  const double ymax = 0.5 * width_ - 1.5 * d_, cell = 2.0 * d_, y0 = bin_->params().origin.y();
   const int nx = std::max(1, static_cast<int>(std::floor((x1 - x0) / cell)));
   const int ny = std::max(1, static_cast<int>(std::floor(2.0 * ymax / cell)));
   const double cx = (x1 - x0) / nx, cy = 2.0 * ymax / ny;
@@ -146,9 +150,9 @@ PatchSoilMeasure SoilPatch::Measure(double x0, double x1) const {
   const double z_layer = floor_z_ + 0.75 * depth0_;
   int counted = 0, reemitted = 0;
   dem.ForEachParticle([&](int id, const Vector3d& x, const Vector3d&) {
-    if (!(x.x() >= x0 && x.x() < x1 && std::abs(x.y()) < ymax)) return;
+    if (!(x.x() >= x0 && x.x() < x1 && InSoil(x.y() - y0))) return;
     const int ix = std::min(nx - 1, static_cast<int>((x.x() - x0) / cx));
-    const int iy = std::min(ny - 1, static_cast<int>((x.y() + ymax) / cy));
+    const int iy = std::min(ny - 1, static_cast<int>((x.y() - y0 + ymax) / cy));
     double& t = top[static_cast<size_t>(ix) * ny + iy];
     t = std::max(t, x.z());
     if (x.z() < z_layer) ++counted;
@@ -163,7 +167,7 @@ PatchSoilMeasure SoilPatch::Measure(double x0, double x1) const {
       ++columns;
     }
   if (columns > 0) m.surface = sum / columns;
-  m.density = counted * dem.mass() / ((x1 - x0) * 2.0 * ymax * 0.75 * depth0_);
+  m.density = counted * dem.mass() / ((x1 - x0) * band_width_ * 0.75 * depth0_);
   m.reemitted_fraction = m.particles > 0 ? static_cast<double>(reemitted) / m.particles : 0.0;
   return m;
 }
@@ -178,10 +182,10 @@ void SoilPatch::StartCopy() {
     // face at its columns' 5th percentile). The face: per column (y and z cells a diameter wide,
     // away from the side walls and below the surface layer) its foremost particle, and of these
     // the median (the 25th to 80th percentiles gave a seam of 0.93-0.95, as between two copies)
-    const double ymax = 0.5 * width_ - 1.5 * d_, y0 = bin_->params().origin.y(), ztop = surface0_ - d_;
+    const double y0 = bin_->params().origin.y(), ztop = surface0_ - d_;
     std::map<std::pair<long, long>, double> columns;
     bin_->dem().ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
-      if (x.x() < front_x0_ - 1.0 || x.x() > front_x0_ + 2.0 * d_ || std::abs(x.y() - y0) > ymax || x.z() > ztop) return;
+      if (x.x() < front_x0_ - 1.0 || x.x() > front_x0_ + 2.0 * d_ || !InSoil(x.y() - y0) || x.z() > ztop) return;
       const std::pair<long, long> key(std::lround(std::floor((x.y() - y0) / d_)),
                                       std::lround(std::floor((x.z() - floor_z_) / d_)));
       auto it = columns.emplace(key, x.x()).first;
@@ -267,6 +271,12 @@ void SoilPatch::Emit() {
   }
 }
 
+bool SoilPatch::InSoil(double y) const {
+  for (const auto& b : bands_)
+    if (y > b.first && y < b.second) return true;
+  return false;
+}
+
 double SoilPatch::ToolWorkingHeight() const { return surface0_ + p_.leveling_clearance * d_; }
 
 void SoilPatch::PlaceTools(double velocity) {
@@ -314,13 +324,20 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   centroid /= wheels.size();
   const double front = 0.5 * (wheels[0].x() + wheels[1].x());
   // a wheel past the side walls is off the soil: the run cannot go on as a run on this soil
-  const double y_max = 0.5 * width_ - 0.5 * bin_->tire().width;
-  for (size_t i = 0; i < wheels.size(); ++i)
-    if (std::abs(wheels[i].y() - bin_->params().origin.y()) > y_max)
-      throw SimulationError(detail::Concat("dem_soil patch (", bin_->params().file, "): wheel ",
-                                           wheels.size() == kWheels ? kWheelNames[i] : std::to_string(i), " is at y = ",
-                                           wheels[i].y(), " m, off the soil (the patch is ", width_, " m wide, levels.",
-                                           bin_->params().level.name, ".width): the vehicle veered off its course"));
+  const DemSoilParams& bp = bin_->params();
+  const double half_tire = 0.5 * bin_->tire().width;
+  for (size_t i = 0; i < wheels.size(); ++i) {
+    const double y = wheels[i].y() - bp.origin.y();
+    bool on = false;
+    for (const auto& b : bp.SoilBands()) on = on || (y >= b.first + half_tire && y <= b.second - half_tire);
+    if (!on)
+      throw SimulationError(detail::Concat(
+          "dem_soil patch (", bp.file, "): wheel ", wheels.size() == kWheels ? kWheelNames[i] : std::to_string(i),
+          " is at y = ", wheels[i].y(), " m, off the soil (",
+          bp.strip_width > 0.0 ? detail::Concat("strips ", bp.strip_width, " m wide at y = +-", bp.strip_offset, " m, track_strip_width")
+                               : detail::Concat("the patch is ", width_, " m wide, levels.", bp.level.name, ".width"),
+          "): the vehicle veered off its course"));
+  }
   if (!started_) {
     started_ = true;
     tool_offset_ = front + p_.leveling_ahead - centre0_.x();

@@ -28,6 +28,7 @@ TerrainVehicle TerrainVehicleOf(const VehicleSpec& spec) {
   v.wheels = kWheels;
   v.track = 2.0 * std::max(std::abs(spec.suspension_front.hardpoints.spindle.y()),
                            std::abs(spec.suspension_rear.hardpoints.spindle.y()));
+  v.wheelbase = spec.wheelbase;
   return v;
 }
 

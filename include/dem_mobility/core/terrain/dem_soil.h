@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dem_mobility/core/cosim/exchange.h"
@@ -82,8 +83,20 @@ struct DemSoilParams {
   int threads = 1;
   unsigned seed = 1;
   double max_overlap = 0.4;         ///< overlap watchdog, fraction of d
+  /// [m] `track_strip_width`: > 0, soil only in two strips this wide centred under the wheel tracks
+  /// (at y = +-strip_offset from the bin's centre line), each between walls of its own, with a
+  /// rigid floor at the bed's nominal depth between and beside them (a scene that needs no soil
+  /// between the tracks); 0, soil over the bin's whole width
+  double strip_width = 0.0;
+  double strip_offset = 0.0;        ///< [m] each strip's centre line from the bin's: half the vehicle's track
+  /// The soil's extent across the bin: [lo, hi] in y from its centre line, one band (the whole
+  /// width) or two strips.
+  std::vector<std::pair<double, double>> SoilBands() const;
+  /// The soil's width across y: the bands' sum.
+  double SoilWidth() const;
   /// Reads the bin's keys from `y` (soil, fidelity, levels, cohesion_factor or cone_index with
-  /// calibration, friction, bin, lid, tire_contact, threads, seed); the caller finishes `y`.
+  /// calibration, friction, bin, lid, tire_contact, threads, seed, track_strip_width); the caller
+  /// finishes `y`.
   /// ConfigError names the file and key.
   static DemSoilParams Read(const YamlReader& y);
   int ParticleCount() const;

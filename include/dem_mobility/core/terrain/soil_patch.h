@@ -104,7 +104,8 @@ class SoilPatch {
   /// The emitter's zone: the layer being filled spans [emitter_from, emitter_to] along x.
   double emitter_from() const;
   double emitter_to() const;
-  /// The soil in [x0, x1) (|y| within the side walls less 1.5 d).
+  /// The soil in [x0, x1) (y within the soil's side walls less 1.5 d: the whole width, or the
+  /// two strips under the wheel tracks).
   PatchSoilMeasure Measure(double x0, double x1) const;
   int initial_particles() const { return n0_; }
 
@@ -125,12 +126,16 @@ class SoilPatch {
   void PlaceTools(double velocity);
   /// The plate's height once lowered: the initial surface plus the leveling clearance.
   double ToolWorkingHeight() const;
+  /// Whether y (from the bin's centre line) lies in the soil's bands, 1.5 d inside their walls.
+  bool InSoil(double y) const;
 
   DemSoilBin* bin_;
   SoilPatchParams p_;
   std::mt19937_64 rng_;
   double d_ = 0.0, bed_length_ = 0.0, width_ = 0.0, floor_z_ = 0.0, surface0_ = 0.0, depth0_ = 0.0;
   double front_x0_ = 0.0, template_length_ = 0.0, min_site_x_ = 0.0;
+  std::vector<std::pair<double, double>> bands_;  ///< the soil's [lo, hi] in y, 1.5 d inside its walls
+  double band_width_ = 0.0;          ///< their sum
   double period_ = 0.0;              ///< shift from one copy to the next
   int seam_clash_ = 0;               ///< sites of a copy that clash with the copy before at that shift
   Eigen::Vector3d centre0_ = Eigen::Vector3d::Zero(), centre_ = Eigen::Vector3d::Zero();

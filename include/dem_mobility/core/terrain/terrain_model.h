@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dem_mobility/core/cosim/exchange.h"
@@ -32,6 +33,10 @@ struct TerrainDisplay {
   double sphere_radius = 0.0;
   double box_rear = 0.0, box_front = 0.0, box_width = 0.0, floor_z = 0.0, box_height = 0.0;
   double emitter_from = 0.0, emitter_to = 0.0;  ///< the layer the emitter fills (x)
+  /// The soil's strips under the wheel tracks ([lo, hi] in y; empty: soil over the box's width)
+  /// and the height of the rigid floor between and beside them.
+  std::vector<std::pair<double, double>> strips;
+  double strip_floor_z = 0.0;
 };
 
 class TerrainModel {
@@ -64,6 +69,7 @@ struct TerrainVehicle {
   TireGeometry tire;
   int wheels = 4;
   double track = 0.0;  ///< [m] between the wheel centres of the wider axle (0: unknown)
+  double wheelbase = 0.0;  ///< [m] between the front and rear axles (0: unknown)
 };
 
 struct VehicleSpec;
