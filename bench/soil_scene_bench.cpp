@@ -1,10 +1,14 @@
 // soil_scene: the vehicle on the moving soil patch, per fidelity level. For each level: the soil
-// prepared (its wall time), the vehicle settled and driving, then a timed window of the whole
-// coupled step (vehicle, tires, patch emission and leveling, soil); wall seconds per simulated
-// second, and particle-steps per second of the coupled step against the bare soil patch (the same
-// soil, in the same state, with the tires lifted clear and no patch) over the same steps.
+// prepared (its wall time), the vehicle settled and driving, then two timed windows of the whole
+// coupled step (vehicle, tires, patch emission and leveling, soil): 0.2 s into the drive (before
+// the patch follows), and once the patch has followed the vehicle for DM_SOIL_FOLLOW s (0.3; the
+// emitter laying soil ahead); wall seconds per simulated second, and particle-steps per second of
+// the coupled step against the bare soil patch (the same soil, in the same state, with the tires
+// and tools lifted clear and no patch) over the same steps. The LEVEL_rate_ratio and
+// LEVEL_wall_s_per_sim_s lines (and the mean rate_ratio_to_bare_soil) are the following window's.
 //   soil_scene_bench SCENE.yaml LEVEL[,LEVEL...] [window_s] [key=value ...]
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <sstream>
 #include <string>
@@ -25,16 +29,6 @@ double Seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Stops the run `after` simulated seconds of driving.
-class StopAfter final : public CoSimObserver {
- public:
-  explicit StopAfter(double after) : after_(after) {}
-  void OnStep(const VehicleCoSim& sim, const DriverCommand&) override { t_ = sim.driver_time(); }
-  bool StopRequested() override { return t_ >= after_; }
-
- private:
-  double after_, t_ = -1.0;
-};
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -49,6 +43,9 @@ int main(int argc, char** argv) {
     while (std::getline(ss, l, ',')) levels.push_back(l);
   }
   const double window = argc > 3 ? std::stod(argv[3]) : 0.05;
+  // [s] the patch follows the vehicle this long before the second window
+  const char* follow_env = std::getenv("DM_SOIL_FOLLOW");
+  const double follow = follow_env ? std::stod(follow_env) : 0.3;
   std::vector<std::string> overrides;
   for (int i = 4; i < argc; ++i) overrides.push_back(argv[i]);
   double ratio_sum = 0.0;
@@ -69,43 +66,81 @@ int main(int argc, char** argv) {
       std::printf("soil_scene %s_particles %d count\n", level.c_str(), n);
       std::printf("soil_scene %s_prepare_wall %.1f s\n", level.c_str(), prepare);
       std::fflush(stdout);
-      // settle and drive 0.2 s (the wheels rolling, the patch in place), then the timed window
+      // two windows of the whole coupled step, each against the bare soil in the same state:
+      // 0.2 s into the drive (the wheels rolling, the patch in place, nothing emitted yet), and
+      // once the patch has followed the vehicle for `follow` s (the emitter laying soil ahead, the
+      // leveling tools moving: what most of a run's simulated time is)
       MobilityRun run(p, std::move(terrain));
-      StopAfter warm(0.2);
-      MobilityRunResult r = run.Run(&warm);
-      if (!r.error.empty()) throw SimulationError(r.error);
       VehicleCoSim& sim = run.sim();
-      const long steps = std::max(1L, std::lround(window / sim.dt()));
-      const long soil0 = soil->bin().dem().step_count();
-      t0 = std::chrono::steady_clock::now();
-      for (long k = 0; k < steps; ++k) sim.Step(run.terrain_port());
-      const double coupled = Seconds(t0);
-      const long soil_steps = soil->bin().dem().step_count() - soil0;
-      // the bare soil: a copy of the soil now, the tires lifted 10 m and stopped
-      DemSystem bare(soil->bin().dem());
-      for (int w = 0; w < soil->bin().wheels(); ++w) {
-        DemWall& t = bare.mutable_wall(soil->bin().tire_wall(w));
-        t.position.z() += 10.0;
-        t.velocity.setZero();
-        t.angular_velocity.setZero();
+      const SoilPatch* patch = soil->patch();
+      double ratio = 0.0;
+      for (const bool following : {false, true}) {
+        const std::string tag = following ? "" : "_before_following";
+        struct Warm final : public CoSimObserver {
+          const SoilPatch* patch;
+          bool following;
+          double drive, follow, t = -1.0, since = -1.0;
+          void OnStep(const VehicleCoSim& s, const DriverCommand&) override {
+            t = s.driver_time();
+            if (patch && patch->stats().following && since < 0.0) since = s.time();
+            follow_t = since < 0.0 ? -1.0 : s.time() - since;
+          }
+          bool StopRequested() override { return following ? follow_t >= follow : t >= drive; }
+          double follow_t = -1.0;
+        } warm;
+        warm.patch = patch;
+        warm.following = following;
+        warm.drive = 0.2;
+        warm.follow = follow;
+        const MobilityRunResult r = run.Run(&warm);
+        if (!r.error.empty()) throw SimulationError(r.error);
+        if (following && !(patch && patch->stats().following))
+          throw SimulationError("the patch never started to follow the vehicle (status " + r.Status() + ")");
+        const long steps = std::max(1L, std::lround(window / sim.dt()));
+        const DemSystem& dem = soil->bin().dem();
+        const long soil0 = dem.step_count(), nb0 = dem.neighbour_builds(), wb0 = dem.wall_builds();
+        const long re0 = patch ? patch->stats().reemitted : 0;
+        t0 = std::chrono::steady_clock::now();
+        for (long k = 0; k < steps; ++k) sim.Step(run.terrain_port());
+        const double coupled = Seconds(t0);
+        const long soil_steps = dem.step_count() - soil0;
+        const long nb = dem.neighbour_builds() - nb0, wb = dem.wall_builds() - wb0;
+        const long reemitted = patch ? patch->stats().reemitted - re0 : 0;
+        // the bare soil: a copy of the soil now, the tires and tools lifted 10 m and stopped
+        DemSystem bare(dem);
+        for (int w = 0; w < soil->bin().wheels(); ++w) {
+          DemWall& t = bare.mutable_wall(soil->bin().tire_wall(w));
+          t.position.z() += 10.0;
+          t.velocity.setZero();
+          t.angular_velocity.setZero();
+        }
+        for (int w : {soil->bin().leveling_cylinder(), soil->bin().leveling_plate()}) {
+          if (w < 0) continue;
+          bare.mutable_wall(w).position.z() += 10.0;
+          bare.mutable_wall(w).velocity.setZero();
+        }
+        const long bnb0 = bare.neighbour_builds(), bwb0 = bare.wall_builds();
+        t0 = std::chrono::steady_clock::now();
+        for (long k = 0; k < soil_steps; ++k) bare.Step();
+        const double bare_wall = Seconds(t0);
+        const double sim_time = steps * sim.dt();
+        const double r_window = bare_wall / coupled;  // (n soil_steps / coupled) / (n soil_steps / bare)
+        const char* lv = level.c_str();
+        std::printf("soil_scene %s_window%s %.4f s_simulated (from t = %.3f s; speed %.2f m/s)\n", lv, tag.c_str(), sim_time,
+                    sim.time() - sim_time, sim.vehicle().ForwardSpeed());
+        std::printf("soil_scene %s_reemitted%s %ld count\n", lv, tag.c_str(), reemitted);
+        std::printf("soil_scene %s_rebuilds%s %ld neighbour %ld wall (bare soil: %ld, %ld) count\n", lv, tag.c_str(), nb, wb,
+                    bare.neighbour_builds() - bnb0, bare.wall_builds() - bwb0);
+        std::printf("soil_scene %s_coupled_rate%s %.3f Mparticle-steps/s\n", lv, tag.c_str(), 1e-6 * n * soil_steps / coupled);
+        std::printf("soil_scene %s_bare_soil_rate%s %.3f Mparticle-steps/s\n", lv, tag.c_str(), 1e-6 * n * soil_steps / bare_wall);
+        std::printf("soil_scene %s_rate_ratio%s %.3f ratio\n", lv, tag.c_str(), r_window);
+        std::printf("soil_scene %s_wall_s_per_sim_s%s %.1f s\n", lv, tag.c_str(), coupled / sim_time);
+        if (following) {
+          std::printf("soil_scene %s_40s_run_extrapolated %.0f s\n", lv, 40.0 * coupled / sim_time + prepare);
+          ratio = r_window;
+        }
+        std::fflush(stdout);
       }
-      for (int w : {soil->bin().leveling_cylinder(), soil->bin().leveling_plate()}) {
-        if (w < 0) continue;
-        bare.mutable_wall(w).position.z() += 10.0;
-        bare.mutable_wall(w).velocity.setZero();
-      }
-      t0 = std::chrono::steady_clock::now();
-      for (long k = 0; k < soil_steps; ++k) bare.Step();
-      const double bare_wall = Seconds(t0);
-      const double sim_time = steps * sim.dt();
-      const double ratio = (static_cast<double>(n) * soil_steps / coupled) / (static_cast<double>(n) * soil_steps / bare_wall);
-      std::printf("soil_scene %s_window %.4f s_simulated\n", level.c_str(), sim_time);
-      std::printf("soil_scene %s_coupled_rate %.3f Mparticle-steps/s\n", level.c_str(), 1e-6 * n * soil_steps / coupled);
-      std::printf("soil_scene %s_bare_soil_rate %.3f Mparticle-steps/s\n", level.c_str(), 1e-6 * n * soil_steps / bare_wall);
-      std::printf("soil_scene %s_rate_ratio %.3f ratio\n", level.c_str(), ratio);
-      std::printf("soil_scene %s_wall_s_per_sim_s %.1f s\n", level.c_str(), coupled / sim_time);
-      std::printf("soil_scene %s_40s_run_extrapolated %.0f s\n", level.c_str(), 40.0 * coupled / sim_time + prepare);
-      std::fflush(stdout);
       ratio_sum += ratio;
       ++ratios;
     } catch (const std::exception& e) {

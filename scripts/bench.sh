@@ -114,8 +114,9 @@ if [ "$want" = all ] || [ "$want" = wheel_soil ]; then
 fi
 
 if [ "$want" = all ] || [ "$want" = soil_scene ]; then
-  # the vehicle on the patch at 12 deg, CI 100, driving; a 0.05 s window per level after the
-  # preparation, 0.3 s of settling and 0.2 s of driving; the soil at the scene's threads (2)
+  # the vehicle on the patch at 12 deg, CI 100, driving; per level after the preparation and
+  # 0.3 s of settling, a 0.05 s window 0.2 s into the drive and one once the patch has followed
+  # the vehicle for DM_SOIL_FOLLOW (0.3) s; the soil at the scene's threads (2)
   "$DM_BUILD/core/bench/soil_scene_bench" "$DM_ROOT/config/scenes/soil_slope.yaml" "${DM_SOIL_LEVELS:-tiny,coarse}" \
     "${DM_SOIL_WINDOW:-0.05}" grade_deg=12 settle_time=0.3 terrain_overrides.cone_index=100
 fi

@@ -3,13 +3,17 @@
 #include <yaml-cpp/yaml.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
 
+#include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/mobility/mobility_run.h"
+#include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 
@@ -161,6 +165,28 @@ TEST(Config, RunnerExitsNonZeroWithTheMessage) {
   ss << in.rdbuf();
   EXPECT_NE(ss.str().find("road_slope.yaml: grade_deg: value 95 is outside the allowed range"), std::string::npos)
       << ss.str();
+}
+
+TEST(Config, SceneTerrainOverridesTakeNestedKeysAsDottedOnes) {
+  // terrain_overrides.levels.tiny.length=6 on the command line makes a nested map in the scene;
+  // it overrides the terrain file's levels.tiny.length as a dotted key written in the scene does
+  const std::string scene = DM_CONFIG_DIR "/scenes/soil_slope.yaml";
+  const MobilityRunParams p = MobilityRunParams::Read(YamlReader::LoadWithOverrides(
+      scene, {"terrain_overrides.levels.tiny.length=6", "terrain_overrides.cone_index=50", "terrain_overrides.fidelity=tiny"}));
+  const std::vector<std::string>& o = p.terrain_overrides;
+  EXPECT_NE(std::find(o.begin(), o.end(), "levels.tiny.length=6"), o.end());
+  EXPECT_NE(std::find(o.begin(), o.end(), "cone_index=50"), o.end());
+  EXPECT_EQ(DescribeTerrain(p.terrain_file, o).fidelity, "tiny");
+  // a misspelt nested key is the terrain file's unknown key, named with its path
+  const MobilityRunParams bad =
+      MobilityRunParams::Read(YamlReader::LoadWithOverrides(scene, {"terrain_overrides.levels.tiny.lenght=6"}));
+  try {
+    DescribeTerrain(bad.terrain_file, bad.terrain_overrides);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("lenght"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("soil_patch.yaml"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Config, RunnerInterruptedKeepsTheRunsResult) {

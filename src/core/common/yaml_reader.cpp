@@ -206,6 +206,8 @@ std::vector<std::string> YamlReader::Keys() const {
   return keys;
 }
 
+bool YamlReader::IsMap(const std::string& key) const { return node_.IsMap() && node_[key] && node_[key].IsMap(); }
+
 YamlReader YamlReader::Child(const std::string& key) const {
   const YAML::Node n = Get(key);
   if (!n.IsMap()) Fail(key, "expected a map of keys, found " + Show(n));

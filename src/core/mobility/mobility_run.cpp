@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 
 #include "dem_mobility/core/common/error.h"
@@ -21,9 +22,19 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
   p.vehicle_file = y.ResolvePath(y.String("vehicle"));
   p.terrain_file = y.ResolvePath(y.String("terrain"));
   if (y.Has("terrain_overrides")) {
-    const YamlReader o = y.Child("terrain_overrides");
-    for (const std::string& k : o.Keys()) p.terrain_overrides.push_back(k + "=" + o.String(k));
-    o.Finish();
+    // (nested maps, as `terrain_overrides.levels.tiny.length=6` on the command line makes them,
+    // stand for dotted keys of the terrain file)
+    const std::function<void(const YamlReader&, const std::string&)> flatten = [&](const YamlReader& o,
+                                                                                   const std::string& prefix) {
+      for (const std::string& k : o.Keys()) {
+        if (o.IsMap(k))
+          flatten(o.Child(k), prefix + k + ".");
+        else
+          p.terrain_overrides.push_back(prefix + k + "=" + o.String(k));
+      }
+      o.Finish();
+    };
+    flatten(y.Child("terrain_overrides"), "");
   }
   p.grade_deg = y.DoubleIn("grade_deg", -45.0, 45.0);
   p.duration = y.DoubleIn("duration", 1e-3, 3600.0);

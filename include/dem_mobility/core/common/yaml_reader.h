@@ -54,6 +54,8 @@ class YamlReader {
   Table1D Table(const std::string& key) const;
 
   YamlReader Child(const std::string& key) const;
+  /// Whether `key` is there and holds a map (not marked as read).
+  bool IsMap(const std::string& key) const;
   /// The keys of this map, in the file's order (not marked as read).
   std::vector<std::string> Keys() const;
 
