@@ -22,7 +22,7 @@ DM_CHECK_PACKAGES=(catkin-lint rviz xvfb imagemagick)
 # only for the dem_step benchmark (the side-by-side LAMMPS run)
 DM_BENCH_PACKAGES=(lammps openmpi-bin)
 
-say() { printf '\n==> %s\n' "$*"; }
+say() { printf '\n==> [%s] %s\n' "$(date -u +%H:%M:%S)" "$*"; }
 
 # Installs the Debian packages that are missing (apt-get update once, only if something is).
 ensure_packages() {

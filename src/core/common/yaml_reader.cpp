@@ -50,6 +50,11 @@ YamlReader YamlReader::LoadWithOverrides(const std::string& path, const std::vec
     YAML::Node node = r.node_;
     for (size_t i = 0; i + 1 < parts.size(); ++i) {
       YAML::Node next = node[parts[i]];
+      // a map the file lacks is added (as a key is: the reader then rejects it if it is unknown)
+      if (!next.IsDefined() || next.IsNull()) {
+        node[parts[i]] = YAML::Node(YAML::NodeType::Map);
+        next = node[parts[i]];
+      }
       if (!next.IsMap()) throw ConfigError(path + ": override '" + kv + "': '" + parts[i] + "' is not a map in the file");
       node.reset(next);
     }

@@ -24,8 +24,8 @@ class YamlReader {
   /// Loads `path`; throws ConfigError naming the file when it is missing or malformed.
   static YamlReader Load(const std::string& path);
   /// Loads `path` and applies `key=value` overrides (dotted keys for nested maps: driver.kp=4000);
-  /// a value is parsed as YAML. An override of a key the file lacks is added, so the reader then
-  /// rejects it if it is unknown.
+  /// a value is parsed as YAML. An override of a key (or map) the file lacks is added, so the
+  /// reader then rejects it if it is unknown.
   static YamlReader LoadWithOverrides(const std::string& path, const std::vector<std::string>& overrides);
   /// Parses text (for tests); `name` stands in for the file name in messages.
   static YamlReader FromString(const std::string& text, const std::string& name = "<string>");
