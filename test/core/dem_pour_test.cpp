@@ -21,7 +21,8 @@ TEST(DemPour, LidConsolidatesThePouredBed) {
   // a random loose packing of spheres in a small walled box: solid fraction between 0.35 and 0.64
   EXPECT_GT(r.density_poured, 0.35 * p.soil.density);
   EXPECT_LT(r.density_poured, 0.64 * p.soil.density);
-  // the lid held its pressure (the mean over the hold, within the 5 % the controller allows)
+  // the lid held its pressure: the hold starts within 5 % of the target, and the bed's creep under
+  // the lid keeps the proportional controller 4.8 % under it on average (soil-model.md): 6 %
   EXPECT_NEAR(r.lid_pressure_reached, 33.3e3, 0.06 * 33.3e3);
   // consolidation: denser and lower after the lid is gone, with plastic strain left
   EXPECT_GT(r.density_consolidated, 1.03 * r.density_poured);
