@@ -10,7 +10,8 @@ value).
 
 Also publishes the map's metadata (nav_msgs/MapMetaData, `<topic>_metadata`, latched). The map
 frame is the raster's CRS shifted so that the map's lower-left corner is at (0, 0) (the YAML's
-`crs_origin` says where), which keeps rviz's float32 coordinates small. Exits with status 2 and a
+`crs_origin` says where), which keeps rviz's float32 coordinates small; that shift is published
+as a static transform from `<frame>_crs` (the CRS's own coordinates) to the map frame. Exits with status 2 and a
 message naming the file when it cannot read it.
 """
 import argparse
@@ -48,6 +49,9 @@ def main(argv=None):
     ap.add_argument('map', help='the ROS map YAML (doe map writes <name>_ros.yaml)')
     ap.add_argument('--frame', default='map', help='frame of the grid (default map)')
     ap.add_argument('--topic', default='map', help='topic (default map; also <topic>_metadata)')
+    ap.add_argument('--crs-frame', default=None,
+                    help='frame of the raster\'s CRS coordinates, the parent of the map frame on /tf_static '
+                         '(translated by the YAML\'s crs_origin; default <frame>_crs)')
     a = ap.parse_args([x for x in (argv if argv is not None else sys.argv[1:]) if not x.startswith('__')])
     import yaml
     from dm_doe.maps import load_ros_map
@@ -64,6 +68,19 @@ def main(argv=None):
     meta = rospy.Publisher(a.topic + '_metadata', MapMetaData, queue_size=1, latch=True)
     pub.publish(grid)
     meta.publish(grid.info)
+    # the map frame in the raster's CRS: a static transform (it also gives rviz its fixed frame)
+    from geometry_msgs.msg import TransformStamped
+    from tf2_msgs.msg import TFMessage
+    with open(a.map) as fh:
+        crs_origin = (yaml.safe_load(fh) or {}).get('crs_origin') or [0.0, 0.0]
+    t = TransformStamped()
+    t.header.stamp = grid.header.stamp
+    t.header.frame_id = a.crs_frame or a.frame + '_crs'
+    t.child_frame_id = a.frame
+    t.transform.translation.x, t.transform.translation.y = float(crs_origin[0]), float(crs_origin[1])
+    t.transform.rotation.w = 1.0
+    tf_static = rospy.Publisher('/tf_static', TFMessage, queue_size=1, latch=True)
+    tf_static.publish(TFMessage(transforms=[t]))
     rospy.loginfo('publish_map: %s: %d x %d cells of %g m on %s (frame %s)', a.map, grid.info.width,
                   grid.info.height, grid.info.resolution, rospy.resolve_name(a.topic), a.frame)
     rospy.spin()

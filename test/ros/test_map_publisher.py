@@ -66,10 +66,18 @@ class MapPublisher(unittest.TestCase):
                       'g = rospy.wait_for_message("/map", OccupancyGrid, timeout=60)\n'
                       'print(g.header.frame_id, g.info.width, g.info.height, g.info.resolution, '
                       'g.info.origin.position.x, g.info.origin.position.y, g.info.origin.orientation.w)\n'
-                      'print(" ".join(str(x) for x in g.data))\n')
+                      'print(" ".join(str(x) for x in g.data))\n'
+                      'from tf2_msgs.msg import TFMessage\n'
+                      't = rospy.wait_for_message("/tf_static", TFMessage, timeout=60).transforms[0]\n'
+                      'print(t.header.frame_id, t.child_frame_id, t.transform.translation.x, t.transform.translation.y)\n')
             q = subprocess.run([sys.executable, '-c', script], capture_output=True, text=True, env=self.env, timeout=90)
             self.assertEqual(q.returncode, 0, q.stderr)
-            head, data = q.stdout.strip().split('\n')[-2:]
+            head, data, tf = q.stdout.strip().split('\n')[-3:]
+            # the map frame in the raster's CRS: its lower-left corner (the geotransform's west
+            # edge, and its north edge less 3 rows of 20 m)
+            tf = tf.split()
+            self.assertEqual(tf[:2], ['map_crs', 'map'])
+            self.assertEqual([float(x) for x in tf[2:]], [500000.0, 4000000.0 - 60.0])
             f = head.split()
             self.assertEqual((f[0], int(f[1]), int(f[2])), ('map', 4, 3))
             self.assertEqual([float(x) for x in f[3:]], [20.0, 0.0, 0.0, 1.0])
