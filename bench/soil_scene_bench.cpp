@@ -66,81 +66,104 @@ int main(int argc, char** argv) {
       std::printf("soil_scene %s_particles %d count\n", level.c_str(), n);
       std::printf("soil_scene %s_prepare_wall %.1f s\n", level.c_str(), prepare);
       std::fflush(stdout);
-      // two windows of the whole coupled step, each against the bare soil in the same state:
-      // 0.2 s into the drive (the wheels rolling, the patch in place, nothing emitted yet), and
-      // once the patch has followed the vehicle for `follow` s (the emitter laying soil ahead, the
-      // leveling tools moving: what most of a run's simulated time is)
+      // two windows of the whole coupled step in one run, each against the bare soil in the
+      // same state: 0.2 s into the drive (the wheels rolling, the patch in place, nothing emitted
+      // yet), and once the patch has followed the vehicle for `follow` s (the emitter laying soil
+      // ahead, the leveling tools moving: what most of a run's simulated time is). The observer
+      // sees every step of the run (the vehicle's steps, the soil's every exchange, the driver):
+      // a window's wall time is that of its steps; the bare soil is timed at the window's end,
+      // between two steps of the run, which then goes on.
       MobilityRun run(p, std::move(terrain));
-      VehicleCoSim& sim = run.sim();
+      const VehicleCoSim& sim = run.sim();
       const SoilPatch* patch = soil->patch();
-      double ratio = 0.0;
-      for (const bool following : {false, true}) {
-        const std::string tag = following ? "" : "_before_following";
-        struct Warm final : public CoSimObserver {
-          const SoilPatch* patch;
-          bool following;
-          double drive, follow, t = -1.0, since = -1.0;
-          void OnStep(const VehicleCoSim& s, const DriverCommand&) override {
-            t = s.driver_time();
-            if (patch && patch->stats().following && since < 0.0) since = s.time();
-            follow_t = since < 0.0 ? -1.0 : s.time() - since;
+      const long window_steps = std::max(1L, std::lround(window / sim.dt()));
+      struct Windows final : public CoSimObserver {
+        const DemSoilTerrain* soil = nullptr;
+        const SoilPatch* patch = nullptr;
+        std::string level;
+        int n = 0;
+        long window_steps = 0;
+        double follow = 0.0, following_since = -1.0, ratio = 0.0;
+        int done = 0;  // windows finished
+        long at = -1;  // the step the window in progress began at (-1: none)
+        long soil0 = 0, nb0 = 0, wb0 = 0, re0 = 0;
+        double t_begin = 0.0;
+        std::chrono::steady_clock::time_point t0;
+        void OnStep(const VehicleCoSim& s, const DriverCommand&) override {
+          const DemSystem& dem = soil->bin().dem();
+          if (patch && patch->stats().following && following_since < 0.0) following_since = s.time();
+          if (at < 0) {
+            const bool begin = done == 0 ? s.driver_time() >= 0.2
+                                         : following_since >= 0.0 && s.time() - following_since >= follow;
+            if (!begin) return;
+            at = s.step();
+            t_begin = s.time();
+            soil0 = dem.step_count();
+            nb0 = dem.neighbour_builds();
+            wb0 = dem.wall_builds();
+            re0 = patch ? patch->stats().reemitted : 0;
+            t0 = std::chrono::steady_clock::now();
+            return;
           }
-          bool StopRequested() override { return following ? follow_t >= follow : t >= drive; }
-          double follow_t = -1.0;
-        } warm;
-        warm.patch = patch;
-        warm.following = following;
-        warm.drive = 0.2;
-        warm.follow = follow;
-        const MobilityRunResult r = run.Run(&warm);
-        if (!r.error.empty()) throw SimulationError(r.error);
-        if (following && !(patch && patch->stats().following))
-          throw SimulationError("the patch never started to follow the vehicle (status " + r.Status() + ")");
-        const long steps = std::max(1L, std::lround(window / sim.dt()));
-        const DemSystem& dem = soil->bin().dem();
-        const long soil0 = dem.step_count(), nb0 = dem.neighbour_builds(), wb0 = dem.wall_builds();
-        const long re0 = patch ? patch->stats().reemitted : 0;
-        t0 = std::chrono::steady_clock::now();
-        for (long k = 0; k < steps; ++k) sim.Step(run.terrain_port());
-        const double coupled = Seconds(t0);
-        const long soil_steps = dem.step_count() - soil0;
-        const long nb = dem.neighbour_builds() - nb0, wb = dem.wall_builds() - wb0;
-        const long reemitted = patch ? patch->stats().reemitted - re0 : 0;
-        // the bare soil: a copy of the soil now, the tires and tools lifted 10 m and stopped
-        DemSystem bare(dem);
-        for (int w = 0; w < soil->bin().wheels(); ++w) {
-          DemWall& t = bare.mutable_wall(soil->bin().tire_wall(w));
-          t.position.z() += 10.0;
-          t.velocity.setZero();
-          t.angular_velocity.setZero();
+          if (s.step() - at < window_steps) return;
+          const double coupled = Seconds(t0);
+          const long soil_steps = dem.step_count() - soil0;
+          const long nb = dem.neighbour_builds() - nb0, wb = dem.wall_builds() - wb0;
+          const long reemitted = patch ? patch->stats().reemitted - re0 : 0;
+          // the bare soil: a copy of the soil now, the tires and tools lifted 10 m and stopped
+          DemSystem bare(dem);
+          for (int w = 0; w < soil->bin().wheels(); ++w) {
+            DemWall& t = bare.mutable_wall(soil->bin().tire_wall(w));
+            t.position.z() += 10.0;
+            t.velocity.setZero();
+            t.angular_velocity.setZero();
+          }
+          for (int w : {soil->bin().leveling_cylinder(), soil->bin().leveling_plate()}) {
+            if (w < 0) continue;
+            bare.mutable_wall(w).position.z() += 10.0;
+            bare.mutable_wall(w).velocity.setZero();
+          }
+          const long bnb0 = bare.neighbour_builds(), bwb0 = bare.wall_builds();
+          const auto tb = std::chrono::steady_clock::now();
+          for (long k = 0; k < soil_steps; ++k) bare.Step();
+          const double bare_wall = Seconds(tb);
+          const double sim_time = s.time() - t_begin;
+          const double r = bare_wall / coupled;  // (n soil_steps / coupled) / (n soil_steps / bare)
+          const std::string tag = done == 0 ? "_before_following" : "";
+          const char *lv = level.c_str(), *tg = tag.c_str();
+          std::printf("soil_scene %s_window%s %.4f s_simulated (t = %.3f-%.3f s, speed %.2f m/s, %ld soil steps)\n", lv, tg,
+                      sim_time, t_begin, s.time(), s.vehicle().ForwardSpeed(), soil_steps);
+          std::printf("soil_scene %s_reemitted%s %ld count\n", lv, tg, reemitted);
+          std::printf("soil_scene %s_rebuilds%s %ld neighbour %ld wall (bare soil: %ld, %ld) count\n", lv, tg, nb, wb,
+                      bare.neighbour_builds() - bnb0, bare.wall_builds() - bwb0);
+          std::printf("soil_scene %s_coupled_rate%s %.3f Mparticle-steps/s\n", lv, tg, 1e-6 * n * soil_steps / coupled);
+          std::printf("soil_scene %s_bare_soil_rate%s %.3f Mparticle-steps/s\n", lv, tg, 1e-6 * n * soil_steps / bare_wall);
+          std::printf("soil_scene %s_rate_ratio%s %.3f ratio\n", lv, tg, r);
+          std::printf("soil_scene %s_wall_s_per_sim_s%s %.1f s\n", lv, tg, coupled / sim_time);
+          std::fflush(stdout);
+          ratio = r;
+          wall_per_sim = coupled / sim_time;
+          ++done;
+          at = -1;
         }
-        for (int w : {soil->bin().leveling_cylinder(), soil->bin().leveling_plate()}) {
-          if (w < 0) continue;
-          bare.mutable_wall(w).position.z() += 10.0;
-          bare.mutable_wall(w).velocity.setZero();
-        }
-        const long bnb0 = bare.neighbour_builds(), bwb0 = bare.wall_builds();
-        t0 = std::chrono::steady_clock::now();
-        for (long k = 0; k < soil_steps; ++k) bare.Step();
-        const double bare_wall = Seconds(t0);
-        const double sim_time = steps * sim.dt();
-        const double r_window = bare_wall / coupled;  // (n soil_steps / coupled) / (n soil_steps / bare)
-        const char* lv = level.c_str();
-        std::printf("soil_scene %s_window%s %.4f s_simulated (from t = %.3f s; speed %.2f m/s)\n", lv, tag.c_str(), sim_time,
-                    sim.time() - sim_time, sim.vehicle().ForwardSpeed());
-        std::printf("soil_scene %s_reemitted%s %ld count\n", lv, tag.c_str(), reemitted);
-        std::printf("soil_scene %s_rebuilds%s %ld neighbour %ld wall (bare soil: %ld, %ld) count\n", lv, tag.c_str(), nb, wb,
-                    bare.neighbour_builds() - bnb0, bare.wall_builds() - bwb0);
-        std::printf("soil_scene %s_coupled_rate%s %.3f Mparticle-steps/s\n", lv, tag.c_str(), 1e-6 * n * soil_steps / coupled);
-        std::printf("soil_scene %s_bare_soil_rate%s %.3f Mparticle-steps/s\n", lv, tag.c_str(), 1e-6 * n * soil_steps / bare_wall);
-        std::printf("soil_scene %s_rate_ratio%s %.3f ratio\n", lv, tag.c_str(), r_window);
-        std::printf("soil_scene %s_wall_s_per_sim_s%s %.1f s\n", lv, tag.c_str(), coupled / sim_time);
-        if (following) {
-          std::printf("soil_scene %s_40s_run_extrapolated %.0f s\n", lv, 40.0 * coupled / sim_time + prepare);
-          ratio = r_window;
-        }
-        std::fflush(stdout);
-      }
+        bool StopRequested() override { return done == 2; }
+        double wall_per_sim = 0.0;
+      } windows;
+      windows.soil = soil;
+      windows.patch = patch;
+      windows.level = level;
+      windows.n = n;
+      windows.window_steps = window_steps;
+      windows.follow = follow;
+      const MobilityRunResult r = run.Run(&windows);
+      if (!r.error.empty()) throw SimulationError(r.error);
+      if (windows.done < 2)
+        throw SimulationError(detail::Concat("the run ended (status ", r.Status(), ") before its windows: ", windows.done,
+                                             " of 2 timed", patch && !patch->stats().following
+                                                                ? " (the patch never started to follow the vehicle)"
+                                                                : ""));
+      std::printf("soil_scene %s_40s_run_extrapolated %.0f s\n", level.c_str(), 40.0 * windows.wall_per_sim + prepare);
+      const double ratio = windows.ratio;
       ratio_sum += ratio;
       ++ratios;
     } catch (const std::exception& e) {

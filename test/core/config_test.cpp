@@ -172,9 +172,11 @@ TEST(Config, SceneTerrainOverridesTakeNestedKeysAsDottedOnes) {
   // it overrides the terrain file's levels.tiny.length as a dotted key written in the scene does
   const std::string scene = DM_CONFIG_DIR "/scenes/soil_slope.yaml";
   const MobilityRunParams p = MobilityRunParams::Read(YamlReader::LoadWithOverrides(
-      scene, {"terrain_overrides.levels.tiny.length=6", "terrain_overrides.cone_index=50", "terrain_overrides.fidelity=tiny"}));
+      scene, {"terrain_overrides.levels.tiny.length=6", "terrain_overrides.cone_index=50", "terrain_overrides.fidelity=tiny",
+              "terrain_overrides.patch.check_window=[0.3, 0.7]"}));
   const std::vector<std::string>& o = p.terrain_overrides;
   EXPECT_NE(std::find(o.begin(), o.end(), "levels.tiny.length=6"), o.end());
+  EXPECT_NE(std::find(o.begin(), o.end(), "patch.check_window=[0.3, 0.7]"), o.end());
   EXPECT_NE(std::find(o.begin(), o.end(), "cone_index=50"), o.end());
   EXPECT_EQ(DescribeTerrain(p.terrain_file, o).fidelity, "tiny");
   // a misspelt nested key is the terrain file's unknown key, named with its path

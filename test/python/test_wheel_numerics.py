@@ -16,24 +16,27 @@ from dm_sweep import wheel_numerics as wn  # noqa: E402
 
 W, B, D, DH = 8560.0, 0.3175, 0.94, 0.15
 # RCI [psi]: N_c VTI, N_c WES, S_sp, DP/W at 20 % slip, MR/W powered, MR/W calibrated (towed)
-TABLE = {20: (4.9, 1.6, 0.39, -0.16, 0.50, 0.34),
-         30: (7.4, 2.4, 0.15, 0.07, 0.23, 0.18),
-         40: (9.9, 3.2, 0.074, 0.23, 0.13, 0.11),
-         60: (14.8, 4.8, 0.030, 0.44, 0.062, 0.062),
-         100: (24.7, 8.0, 0.012, 0.66, 0.027, 0.032)}
+# as printed (strings: a float would drop the trailing zeros of 0.50, 0.030 and 8.0, and with
+# them the digits the entries are given to)
+TABLE = {20: ('4.9', '1.6', '0.39', '-0.16', '0.50', '0.34'),
+         30: ('7.4', '2.4', '0.15', '0.07', '0.23', '0.18'),
+         40: ('9.9', '3.2', '0.074', '0.23', '0.13', '0.11'),
+         60: ('14.8', '4.8', '0.030', '0.44', '0.062', '0.062'),
+         100: ('24.7', '8.0', '0.012', '0.66', '0.027', '0.032')}
 
 
 def half_unit(printed):
-    """Half a unit of the last printed digit of a table entry (0.074 -> 0.0005)."""
-    text = repr(printed)
+    """Half a unit of the last printed digit of a table entry, given as printed ('0.074' -> 0.0005,
+    '0.50' -> 0.005)."""
+    text = printed if isinstance(printed, str) else repr(printed)
     decimals = len(text.split('.')[1]) if '.' in text else 0
     return 0.5 * 10 ** -decimals + 1e-12
 
 
 class BaselineTable(unittest.TestCase):
     def assertPrinted(self, value, printed, what):
-        self.assertLessEqual(abs(value - printed), half_unit(printed),
-                             '%s: %.5f does not print as %r' % (what, value, printed))
+        self.assertLessEqual(abs(value - float(printed)), half_unit(printed),
+                             '%s: %.5f does not print as %s' % (what, value, printed))
 
     def test_sanity_table(self):
         for ci, (nc, nc_wes, ssp, dp20, mr, mr_cal) in TABLE.items():
@@ -50,7 +53,7 @@ class BaselineTable(unittest.TestCase):
         nc = wn.vti_nc(60, B, D, W, DH)
         self.assertAlmostEqual(wn.vti_ssp(nc, offset=0.0), 21.0 / nc ** 2.5)
         self.assertAlmostEqual(wn.vti_ssp(nc) - wn.vti_ssp(nc, 0.0), 0.005)
-        self.assertGreater(abs(wn.vti_ssp(nc, 0.0) - 0.030), half_unit(0.030))
+        self.assertGreater(abs(wn.vti_ssp(nc, 0.0) - 0.030), half_unit('0.030'))
 
     def test_self_propelled_slip_is_zero_pull(self):
         v = wn.vti(60, B, D, W, DH)

@@ -213,6 +213,18 @@ std::vector<std::string> YamlReader::Keys() const {
 
 bool YamlReader::IsMap(const std::string& key) const { return node_.IsMap() && node_[key] && node_[key].IsMap(); }
 
+bool YamlReader::IsList(const std::string& key) const {
+  return node_.IsMap() && node_[key] && node_[key].IsSequence();
+}
+
+std::string YamlReader::FlowText(const std::string& key) const {
+  YAML::Emitter e;
+  e.SetSeqFormat(YAML::Flow);
+  e.SetMapFormat(YAML::Flow);
+  e << Get(key);
+  return e.c_str();
+}
+
 YamlReader YamlReader::Child(const std::string& key) const {
   const YAML::Node n = Get(key);
   if (!n.IsMap()) Fail(key, "expected a map of keys, found " + Show(n));

@@ -29,6 +29,8 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
       for (const std::string& k : o.Keys()) {
         if (o.IsMap(k))
           flatten(o.Child(k), prefix + k + ".");
+        else if (o.IsList(k))  // (terrain_overrides.patch.check_window=[0.3,0.7])
+          p.terrain_overrides.push_back(prefix + k + "=" + o.FlowText(k));
         else
           p.terrain_overrides.push_back(prefix + k + "=" + o.String(k));
       }

@@ -184,7 +184,8 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
     b.second += 0.5 * l.width;
   }
   if (p.strip_width > 0.0) {
-    DM_THROW_UNLESS(p.strip_offset > 0.0, "dem_soil: track strips need the vehicle's track (strip_offset)");
+    if (!(p.strip_offset > 0.0))
+      throw ConfigError(p.file + ": track_strip_width: soil under the wheel tracks needs the vehicle's track (none given)");
     if (tire.width + 2.0 * d > p.strip_width)
       throw ConfigError(detail::Concat(p.file, ": track_strip_width: the strips (", p.strip_width, " m) are narrower than the tire (",
                                        tire.width, " m) plus two particle diameters"));
@@ -222,7 +223,10 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
   box[2] = MakeQuadWall("x1", {l.length, 0, 0}, {0, l.width, 0}, {0, 0, wall_height_});
   if (bands.size() > 1) {
     // each strip between walls of its own (from the floor to the box's height), and a rigid floor
-    // at the bed's nominal depth over the rest of the width: between the strips and beside them
+    // over the rest of the width, between the strips and beside them: 1.5 d below the bed's
+    // nominal surface (soil spilled onto it passes under the leveling plate), and kept half a
+    // diameter from the strips' walls (a particle inside a strip never reaches its edge: pressed by
+    // the wall and by the floor's edge, a particle there would be pushed twice)
     std::vector<double> edges = {0.0};
     for (const auto& b : bands) {
       // (none where a strip's side is the box's: two walls there would press the soil twice)
@@ -233,9 +237,12 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
       edges.push_back(b.second);
     }
     edges.push_back(l.width);
-    for (size_t k = 0; k + 1 < edges.size(); k += 2)
-      if (edges[k + 1] - edges[k] > 1e-9)
-        box.push_back(MakeQuadWall("track_gap_floor", {0, edges[k], l.soil_depth}, {reach, 0, 0}, {0, edges[k + 1] - edges[k], 0}));
+    const double z_gap = std::max(0.5 * d, l.soil_depth - 1.5 * d);
+    for (size_t k = 0; k + 1 < edges.size(); k += 2) {
+      const double y0 = edges[k] > 1e-9 ? edges[k] + 0.5 * d : 0.0;
+      const double y1 = edges[k + 1] < l.width - 1e-9 ? edges[k + 1] - 0.5 * d : l.width;
+      if (y1 - y0 > 1e-9) box.push_back(MakeQuadWall("track_gap_floor", {0, y0, z_gap}, {reach, 0, 0}, {0, y1 - y0, 0}));
+    }
   }
   for (DemWall& w : box) {
     for (Vector3d& v : w.mesh.vertices) v += o;
@@ -413,7 +420,7 @@ TerrainDisplay DemSoilTerrain::Display() const {
   const DemSoilParams& p = bin_->params();
   if (p.strip_width > 0.0) {
     for (const auto& b : p.SoilBands()) d.strips.emplace_back(p.origin.y() + b.first, p.origin.y() + b.second);
-    d.strip_floor_z = bin_->floor_z() + p.level.soil_depth;
+    d.strip_floor_z = bin_->floor_z() + std::max(0.5 * p.level.particle_diameter, p.level.soil_depth - 1.5 * p.level.particle_diameter);
   }
   return d;
 }
@@ -462,6 +469,7 @@ void DemSoilTerrain::Describe(ResultFile* r) const {
   r->Set("patch_density_ratio_max", s.density_ratio_max);
   r->Set("patch_surface_offset", s.surface_offset_mean);
   r->Set("patch_surface_offset_max", s.surface_offset_max);
+  r->Set("patch_bed_slide_speed_max", s.bed_slide_speed_max);
 }
 
 void DemSoilTerrain::Synchronize(long, double, const std::vector<WheelState>& states) {

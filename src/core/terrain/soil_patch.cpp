@@ -384,7 +384,15 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   // dense than the soil leaving at the rear, would otherwise reach past the sphere's front, leave
   // at once and be laid further ahead, without end)
   const double sphere_to = centre_.x();
-  dem.ForEachParticle([&](int id, const Vector3d& x, const Vector3d&) {
+  // (and, once the patch follows, the bed's bottom layer in the middle half of the box, away from
+  // its faces (the rear one, left free as the soil behind it leaves, slumps; the laid front
+  // settles): does the bed slide down the grade on the floor?)
+  const double z_bottom = floor_z_ + d_, slide_lo = centre_.x() - 0.25 * bed_length_, slide_hi = centre_.x() + 0.25 * bed_length_;
+  dem.ForEachParticle([&](int id, const Vector3d& x, const Vector3d& v) {
+    if (stats_.following && x.z() < z_bottom && x.x() > slide_lo && x.x() < slide_hi) {
+      bed_vx_sum_ += v.x();
+      ++bed_vx_count_;
+    }
     if (x.x() < sphere_to && (x - centre_).squaredNorm() > r2) {
       out.push_back(id);
     } else if (stats_.following && (x.x() > zone_to || (emitting && x.x() >= zone_from && id < prev_layer_first_id_))) {
@@ -397,7 +405,15 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   for (int id : out) dem.RemoveParticle(id);
   for (size_t k = 0; k < out.size(); ++k) Emit();
   ++steps_;
-  if (steps_ % check_every_ == 0) Check(front);
+  if (steps_ % check_every_ == 0) {
+    Check(front);
+    if (bed_vx_count_ > 0) {
+      const double down = -bed_vx_sum_ / bed_vx_count_;
+      stats_.bed_slide_speed_max = std::max(stats_.bed_slide_speed_max, down);
+      bed_vx_sum_ = 0.0;
+      bed_vx_count_ = 0;
+    }
+  }
 }
 
 void WritePatchChecks(const PatchStats& s, const std::string& path) {

@@ -54,8 +54,11 @@ class YamlReader {
   Table1D Table(const std::string& key) const;
 
   YamlReader Child(const std::string& key) const;
-  /// Whether `key` is there and holds a map (not marked as read).
+  /// Whether `key` is there and holds a map, or a list (not marked as read).
   bool IsMap(const std::string& key) const;
+  bool IsList(const std::string& key) const;
+  /// The value of `key` written as flow YAML (a list: "[0.3, 0.7]").
+  std::string FlowText(const std::string& key) const;
   /// The keys of this map, in the file's order (not marked as read).
   std::vector<std::string> Keys() const;
 

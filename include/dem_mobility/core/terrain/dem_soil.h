@@ -85,7 +85,7 @@ struct DemSoilParams {
   double max_overlap = 0.4;         ///< overlap watchdog, fraction of d
   /// [m] `track_strip_width`: > 0, soil only in two strips this wide centred under the wheel tracks
   /// (at y = +-strip_offset from the bin's centre line), each between walls of its own, with a
-  /// rigid floor at the bed's nominal depth between and beside them (a scene that needs no soil
+  /// rigid floor 1.5 d below the bed's nominal surface between and beside them (a scene that needs no soil
   /// between the tracks); 0, soil over the bin's whole width
   double strip_width = 0.0;
   double strip_offset = 0.0;        ///< [m] each strip's centre line from the bin's: half the vehicle's track

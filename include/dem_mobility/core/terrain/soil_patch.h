@@ -74,6 +74,10 @@ struct PatchStats {
   double density_ratio_min = std::numeric_limits<double>::quiet_NaN(), density_ratio_max = std::numeric_limits<double>::quiet_NaN();
   double surface_offset_mean = std::numeric_limits<double>::quiet_NaN(); ///< [m] re-emitted - initial
   double surface_offset_max = std::numeric_limits<double>::quiet_NaN();  ///< largest |offset| [m]
+  /// [m/s] the largest mean speed down the grade (-x) of the bed's bottom layer (a diameter deep, in
+  /// the middle half of the box) over the check periods once the patch follows: the bed creeping
+  /// or sliding on the box's floor (reported, not acted on: docs/vehicle-on-soil.md)
+  double bed_slide_speed_max = 0.0;
   std::vector<PatchCheck> log;    ///< every check made, those under 90 % re-emitted soil too
 };
 
@@ -154,6 +158,8 @@ class SoilPatch {
   double tool_z_ = 0.0;              ///< the plate's height now (lowered to its working height)
   double front_offset_ = 0.0;        ///< front wheels' x - wheel centroid x (at the start)
   long steps_ = 0, check_every_ = 1;
+  double bed_vx_sum_ = 0.0;          ///< over this check period: the lower half's velocity along x
+  long bed_vx_count_ = 0;
   double ratio_sum_ = 0.0, offset_sum_ = 0.0;
   PatchStats stats_;
 };
