@@ -81,8 +81,10 @@ class SingleWheelRun(unittest.TestCase):
         # the soil carries the wheel: over the last half its mean upward force is near the load
         last = wrenches[len(wrenches) // 2:]
         fz = sum(m.wrench.force.z for m in last) / len(last)
-        self.assertGreater(fz, 0.5 * self.res['load'])
-        self.assertLess(fz, 2.0 * self.res['load'])
+        print('wheel: mean upward force over the last half %.1f N, load %.1f N' % (fz, self.res['load']))
+        # within 3 % (measured 2026-12-02: 12107.7 N against 12066.3 N, 0.3 %; the core rig test
+        # asserts 1 % over a longer run)
+        self.assertLess(abs(fz - self.res['load']), 0.03 * self.res['load'])
 
     def test_samples_are_the_history(self):
         h = self.res['history']

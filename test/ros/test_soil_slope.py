@@ -194,14 +194,18 @@ class SoilSlopeRuns(unittest.TestCase):
         self.assertEqual(c.get('/tf'), self.res['published']['tf'])
         forces = {m.ns for m in self.msgs[NS + 'vehicle/forces'][-1].markers}
         self.assertTrue({'wheel_forces', 'label'} <= forces, forces)
-        # the soil carries the vehicle (about 5 t, 48 kN normal to a 12 deg slope): over the last half
-        # of the run (it was set down on the soil at the start) every wheel is in contact and the
-        # vertical forces add up to about its weight
+        # the soil carries the vehicle (4,862.9 kg: 46.7 kN normal to the 12 deg slope): over the last
+        # half of this 0.4 s run every wheel is in contact and the vertical forces add up to its
+        # weight and the landing's deceleration (it was set down on the soil, a start gap above it:
+        # measured 2026-12-02, 56.2 kN, 1.20 times the weight; the weight itself within 2 % once
+        # settled is VehicleOnSoil.AtRestCarriesItsWeightAndStopsSinking's)
         ws = self.msgs[NS + 'wheel_wrenches']
         last = ws[len(ws) // 2:]
         fz = sum(sum(x.force.z for x in w.wrenches) for w in last) / len(last)
-        self.assertGreater(fz, 25e3)
-        self.assertLess(fz, 100e3)
+        print('vehicle: the wheels carry %.0f N over the last half of the run' % fz)
+        weight_normal = 4862.9 * 9.81 * math.cos(math.radians(12.0))  # (config/vehicles/hmmwv/nrmm.yaml: gross_mass)
+        self.assertGreater(fz, 0.8 * weight_normal)
+        self.assertLess(fz, 1.5 * weight_normal)
         self.assertTrue(all(n > 0 for w in last for n in w.contacts))
 
     def test_rviz_view_shows_the_bags_topics(self):
