@@ -60,7 +60,8 @@ SoilPatch::SoilPatch(DemSoilBin* bin, const SoilPatchParams& p, unsigned seed)
   const double rear = bp.origin.x();
   front_x0_ = rear + bed_length_;
   n0_ = dem.size();
-  for (const auto& b : bp.SoilBands()) {
+  walls_y_ = bp.SoilBands();
+  for (const auto& b : walls_y_) {
     bands_.emplace_back(b.first + 1.5 * d_, b.second - 1.5 * d_);
     band_width_ += bands_.back().second - bands_.back().first;
   }
@@ -329,7 +330,7 @@ void SoilPatch::BeforeStep(const std::vector<Vector3d>& wheels) {
   for (size_t i = 0; i < wheels.size(); ++i) {
     const double y = wheels[i].y() - bp.origin.y();
     bool on = false;
-    for (const auto& b : bp.SoilBands()) on = on || (y >= b.first + half_tire && y <= b.second - half_tire);
+    for (const auto& b : walls_y_) on = on || (y >= b.first + half_tire && y <= b.second - half_tire);
     if (!on)
       throw SimulationError(detail::Concat(
           "dem_soil patch (", bp.file, "): wheel ", wheels.size() == kWheels ? kWheelNames[i] : std::to_string(i),

@@ -138,7 +138,8 @@ class SoilPatch {
   std::mt19937_64 rng_;
   double d_ = 0.0, bed_length_ = 0.0, width_ = 0.0, floor_z_ = 0.0, surface0_ = 0.0, depth0_ = 0.0;
   double front_x0_ = 0.0, template_length_ = 0.0, min_site_x_ = 0.0;
-  std::vector<std::pair<double, double>> bands_;  ///< the soil's [lo, hi] in y, 1.5 d inside its walls
+  std::vector<std::pair<double, double>> walls_y_;  ///< the soil's [lo, hi] in y between its side walls
+  std::vector<std::pair<double, double>> bands_;  ///< the same, 1.5 d inside its walls
   double band_width_ = 0.0;          ///< their sum
   double period_ = 0.0;              ///< shift from one copy to the next
   int seam_clash_ = 0;               ///< sites of a copy that clash with the copy before at that shift
