@@ -48,14 +48,17 @@ build_core() {
   cmake --build "$DM_BUILD/core" -j"$(nproc)"
 }
 
-# catkin workspace whose src/ links to this checkout; builds the ROS layer.
+# catkin workspace whose src/ links to this checkout; builds the ROS layer. It links build_core's
+# libdm_core.a (DM_CORE_PREBUILT; it brings build_core up to date first) and leaves the core tests
+# and benchmarks to build_core: nothing is compiled twice.
 build_catkin() {
   local ws="$DM_WS"
+  build_core >/dev/null  # (up to date already when the caller has just built it: seconds)
   say "build: catkin workspace $ws"
   mkdir -p "$ws/src" "$DM_BUILD"
   touch "$DM_BUILD/CATKIN_IGNORE"  # catkin must not take build/ for part of the package
   ln -sfn "$DM_ROOT" "$ws/src/dem_mobility"
-  (cd "$ws" && catkin_make -DCMAKE_BUILD_TYPE=Release -DCATKIN_ENABLE_TESTING=ON -j"$(nproc)" >"$DM_BUILD/catkin_make.log" 2>&1) \
+  (cd "$ws" && catkin_make -DCMAKE_BUILD_TYPE=Release -DCATKIN_ENABLE_TESTING=ON -DDM_BUILD_TESTS=OFF -DDM_BUILD_BENCH=OFF -DDM_CORE_PREBUILT="$DM_BUILD/core/src/core/libdm_core.a" -j"$(nproc)" >"$DM_BUILD/catkin_make.log" 2>&1) \
     || { tail -40 "$DM_BUILD/catkin_make.log"; echo "catkin_make failed; full log: $DM_BUILD/catkin_make.log"; exit 1; }
   tail -3 "$DM_BUILD/catkin_make.log"
 }
