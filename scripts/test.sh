@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs every test:
-#  1. the core GoogleTest suite with plain CMake (no ROS master),
+#  1. the core GoogleTest suite with plain CMake (no ROS master), in the background beside 2-4,
 #  2. the catkin build of the whole package, then its catkin tests: roslaunch-check on every launch
 #     file and the rostest of the lock-step exchange (test/ros/road_scene.test),
 #  3. the end-to-end road runs through roslaunch (test/ros/test_road_runs.py), the cone index
@@ -11,8 +11,16 @@
 source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_MAP_PACKAGES[@]}" "${DM_SLURM_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
 build_core
-say "test: core suite (ctest, no ROS master)"
-(cd "$DM_BUILD/core" && ctest --output-on-failure --timeout 1200 -j2)
+# The core suite is CPU-bound (its tests run side by side on both cores); the stages after it
+# (builds, ROS and python tests) wait on processes, masters and a Slurm scheduler much of the
+# time. So the core suite runs in the background beside them, and its outcome is read at the end.
+say "test: core suite (ctest, no ROS master) started in the background (its log: $DM_BUILD/ctest.log)"
+rm -f "$DM_BUILD/ctest.rc"
+# its own process group (setsid), so that a failing stage below stops it and its tests too
+setsid bash -c 'cd "$1/core" && ctest --output-on-failure --timeout 1200 -j2 >"$1/ctest.log" 2>&1; echo $? >"$1/ctest.rc"' \
+  _ "$DM_BUILD" &
+ctest_pid=$!
+trap 'kill -- -"$ctest_pid" 2>/dev/null || true' EXIT
 build_catkin
 ros_env
 say "test: catkin tests (roslaunch-check, rostest)"
@@ -38,4 +46,9 @@ say "test: catkin_lint"
 lint=$(cd "$DM_WS/src" && catkin_lint dem_mobility 2>&1 | grep -v rosdep)
 echo "$lint"
 echo "$lint" | grep -q "found 0 problems" || { echo "catkin_lint reported problems"; exit 1; }
+say "test: core suite (ctest): waiting for it"
+wait "$ctest_pid" || true
+trap - EXIT
+cat "$DM_BUILD/ctest.log"
+[ "$(cat "$DM_BUILD/ctest.rc" 2>/dev/null)" = 0 ] || { echo "core suite failed (log: $DM_BUILD/ctest.log)"; exit 1; }
 say "test: all passed"
