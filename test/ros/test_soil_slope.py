@@ -13,8 +13,8 @@ preparation dominates):
   for its wall time);
 - a cone index outside the calibration table is refused naming the terrain file and the key.
 
-The runs use a copy of the scene at the tiny level, CI 100, in a 6 m box (the copy names its files
-absolutely).
+The runs use a copy of the scene at the tiny level, CI 100, in a 6 m box with the soil under the
+wheel tracks only (the copy names its files absolutely).
 
     python3 test/ros/test_soil_slope.py   (after the catkin build; needs the workspace sourced)
 """
@@ -40,15 +40,16 @@ WALL_KEYS = {'wall_time', 'real_time_factor', 'soil_prepare_wall_time', 'soil_ad
 
 
 def tiny_scene(tmp):
-    """A copy of soil_slope.yaml at the tiny level, CI 100 (the level's table), in a 6 m box (an
-    option the scene allows; the preparation is what these short runs spend their time on)."""
+    """A copy of soil_slope.yaml at the tiny level, CI 100 (the level's table), in a 6 m box, the
+    soil only under the wheel tracks (0.9 m strips): options the scene allows, which halve the
+    particles; the preparation is what these short runs spend their time on."""
     with open(os.path.join(ROOT, 'config', 'scenes', 'soil_slope.yaml')) as f:
         s = yaml.safe_load(f)
     s['vehicle'] = os.path.join(ROOT, 'config', 'vehicles', 'hmmwv', 'vehicle.yaml')
     s['terrain'] = os.path.join(ROOT, 'config', 'terrains', 'soil_patch.yaml')
     # a 6 m box (the laid soil nearer the front wheels: the checks look nearer, as the box needs)
     s['terrain_overrides'] = {'fidelity': 'tiny', 'cone_index': 100, 'levels.tiny.length': 6.0,
-                              'patch.check_window': '[0.3, 0.7]'}
+                              'patch.check_window': '[0.3, 0.7]', 'track_strip_width': 0.9}
     scene = os.path.join(tmp, 'soil_slope_tiny.yaml')
     with open(scene, 'w') as f:
         yaml.safe_dump(s, f, sort_keys=False)
@@ -184,7 +185,9 @@ class SoilSlopeRuns(unittest.TestCase):
         self.assertEqual(len(tools), len(clouds))
         self.assertEqual([m.header.stamp for m in tools[-1].markers], [last.header.stamp] * len(tools[-1].markers))
         names = {m.ns for m in tools[-1].markers}
-        self.assertEqual(names, {'leveling_cylinder', 'leveling_plate', 'patch_sphere', 'patch_box', 'patch_emitter'})
+        # (the strips: the soil's two bands under the wheel tracks, drawn with the patch)
+        self.assertEqual(names, {'leveling_cylinder', 'leveling_plate', 'patch_sphere', 'patch_box', 'patch_emitter',
+                                 'patch_strips'})
         self.assertTrue(all(m.header.frame_id == 'odom' for m in tools[-1].markers))
         self.assertEqual(c.get(NS + 'terrain/markers'), 1)
         self.assertEqual(c.get(NS + 'result'), 1)
