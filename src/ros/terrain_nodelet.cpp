@@ -35,7 +35,8 @@ namespace dem_mobility {
 class TerrainNodelet : public nodelet::Nodelet {
  public:
   ~TerrainNodelet() override {
-    if (prepare_.joinable()) prepare_.join();  // a preparation cannot be cut short
+    stop_prepare_ = true;  // a preparation in progress stops within a step
+    if (prepare_.joinable()) prepare_.join();
     responder_.reset();  // the vehicle learns at once that its terrain is gone
     if (served_ > 0) NODELET_INFO("terrain: %lu exchanges answered", static_cast<unsigned long>(served_));
   }
@@ -76,9 +77,11 @@ class TerrainNodelet : public nodelet::Nodelet {
         NODELET_INFO("terrain '%s' from %s (level '%s'): preparing ...", d.model.c_str(), scene.terrain_file.c_str(),
                      d.fidelity.c_str());
       const auto t0 = std::chrono::steady_clock::now();
+      // a shutdown (SIGINT, SIGTERM, the manager unloading this nodelet) stops the preparation
+      // within a step: the exchange is then closed with the reason, so the vehicle's wait ends
       std::unique_ptr<TerrainModel> model =
           LoadTerrainModel(scene.terrain_file, TerrainVehicleOf(VehicleSpec::Load(scene.vehicle_file)),
-                           scene.terrain_overrides);
+                           scene.terrain_overrides, [this] { return stop_prepare_.load() || !ros::ok(); });
       model->SetGravity(VehicleCoSim::GradeGravity(scene.grade_deg));  // the soil on the grade, as in-process
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       server = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
@@ -94,6 +97,9 @@ class TerrainNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(mutex_);
       model_ = std::move(model);
       PublishSurface();
+    } catch (const core::Interrupted& e) {  // a shutdown during the preparation: no failure of the terrain's
+      Refuse(transport, e.what(), false);
+      return;
     } catch (const std::exception& e) {
       Refuse(transport, e.what());
       return;
@@ -104,9 +110,13 @@ class TerrainNodelet : public nodelet::Nodelet {
         [this](const std::string& m) { NODELET_INFO("%s", m.c_str()); });
   }
 
-  /// The terrain could not start: said clearly; the vehicle finds the exchange closed with the reason.
-  void Refuse(const std::string& transport, const std::string& what) {
-    NODELET_FATAL("%s", what.c_str());
+  /// The terrain could not start: said clearly (`fatal`: an error; else, a shutdown, a warning); the
+  /// vehicle finds the exchange closed with the reason.
+  void Refuse(const std::string& transport, const std::string& what, bool fatal = true) {
+    if (fatal)
+      NODELET_FATAL("%s", what.c_str());
+    else
+      NODELET_WARN("%s", what.c_str());
     {
       std::lock_guard<std::mutex> lock(mutex_);
       error_ = what;
@@ -304,6 +314,7 @@ class TerrainNodelet : public nodelet::Nodelet {
   std::string error_;
   std::unique_ptr<ExchangeResponder<WheelStates, WheelWrenches>> responder_;
   std::shared_ptr<Channel<WheelStates, WheelWrenches>> failed_;  ///< held closed when the setup failed
+  std::atomic<bool> stop_prepare_{false};
   std::thread prepare_;
   ros::Publisher markers_, cloud_, tools_;
   ros::ServiceServer report_;

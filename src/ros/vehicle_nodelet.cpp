@@ -220,7 +220,20 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       wall0_ = std::chrono::steady_clock::now();
       r = RunCoSimulation(*sim_, *terrain_, *driver_, this);
     } catch (const std::exception& e) {  // configuration errors (time step) before the first step
-      r.error = e.what();
+      if (stop_ || !ros::ok()) {
+        // a shutdown before the run began (e.g. while the soil was being prepared): interrupted,
+        // with the reason the exchange gave
+        r.interrupted = true;
+        interrupted_why_ = e.what();
+        try {
+          r.terrain = DescribeTerrain(scene_.terrain_file, scene_.terrain_overrides);
+          r.terrain_model = r.terrain.model;
+          r.cone_index = r.terrain.cone_index;
+        } catch (const std::exception&) {
+        }
+      } else {
+        r.error = e.what();
+      }
     }
     const std::string why = !r.error.empty() ? "the vehicle stopped: " + r.error : "the vehicle finished";
     terrain_->Leave(why);
@@ -321,7 +334,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     m.simulated_time = r.sim_time;
     m.wall_time = r.wall_time;
     m.real_time_factor = r.wall_time > 0.0 ? r.sim_time / r.wall_time : 0.0;  // as in the result YAML
-    m.error = r.error;
+    m.error = r.error.empty() ? interrupted_why_ : r.error;
     result_.Publish(m);
     if (!r.error.empty()) NODELET_ERROR("run failed: %s", r.error.c_str());
     NODELET_INFO("speed_made_good: %.3f m/s (%.2f mph), status %s; %ld steps, %.2f s driven in %.2f s wall",
@@ -333,6 +346,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
         // as the in-process runner writes it (MobilityResultFile with the terrain model): the
         // terrain's figures after the run's, in the terrain's order
         ResultFile f = MobilityResultFile(r, scene_, counts);
+        if (r.Status() == "interrupted" && !interrupted_why_.empty()) f.SetStatus("interrupted", interrupted_why_);
         for (const auto& kv : terrain) f.Set(kv.first.as<std::string>(), kv.second);
         if (!report_error.empty()) f.Set("terrain_report", "missing: " + report_error);
         f.Write(result_file_);
@@ -399,6 +413,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   std::unique_ptr<ExchangeTerrainPort> terrain_;
   std::unique_ptr<ExchangeDriverPort> driver_;
   std::string world_frame_, map_frame_, base_frame_, result_file_;
+  std::string interrupted_why_;  ///< why a run was interrupted before it began (the exchange's reason)
   double log_rate_ = 100.0, clock_rate_ = 100.0, max_rtf_ = 0.0, force_scale_ = 1e-4;
   bool wait_for_recorder_ = true, shutdown_when_done_ = false;
   long log_every_ = 1, clock_every_ = 1;

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -215,6 +216,41 @@ TEST(Config, RunnerInterruptedKeepsTheRunsResult) {
   long lines = 0;
   while (std::getline(h, line)) ++lines;
   EXPECT_GT(lines, 10);  // the samples so far (100 Hz)
+}
+
+TEST(Config, RunnerInterruptedWhileTheSoilIsPreparedStopsWithinASecond) {
+  // a soil scene (the tiny level: its preparation takes some 15-35 s here) sent SIGTERM 1 s after
+  // its start, in the soil's preparation: it stops within a second of the signal (the preparation
+  // polls the stop at every step), writes its result (status interrupted, the phase reached) and
+  // the history's header, and exits 4
+  const fs::path dir = fs::temp_directory_path() / "dm_runner_interrupt_prep";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string result = (dir / "r.yaml").string(), history = (dir / "h.csv").string();
+  const std::string cmd = "timeout --preserve-status -s TERM 1 " + std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR
+                          "/scenes/soil_slope.yaml terrain_overrides.fidelity=tiny terrain_overrides.threads=1 "
+                          "--quiet --out " + result + " --history " + history + " > " + (dir / "out.txt").string() +
+                          " 2> " + (dir / "err.txt").string();
+  const auto t0 = std::chrono::steady_clock::now();
+  const int rc = std::system(cmd.c_str());
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(WIFEXITED(rc));
+  EXPECT_EQ(WEXITSTATUS(rc), 4);
+  EXPECT_LT(wall, 2.0);  // 1 s to the signal, then within a second
+  const YAML::Node r = YAML::LoadFile(result);
+  EXPECT_EQ(r["status"].as<std::string>(), "interrupted");
+  EXPECT_TRUE(r["interrupted"].as<bool>());
+  const std::string why = r["error"].as<std::string>();
+  EXPECT_NE(why.find("interrupted while the soil"), std::string::npos) << why;
+  EXPECT_NE(why.find("being prepared: phase "), std::string::npos) << why;
+  EXPECT_EQ(r["terrain_model"].as<std::string>(), "dem_soil");
+  EXPECT_EQ(r["fidelity"].as<std::string>(), "tiny");
+  EXPECT_EQ(r["simulated_time"].as<double>(), 0.0);
+  std::ifstream h(history);
+  std::string line;
+  ASSERT_TRUE(static_cast<bool>(std::getline(h, line)));  // the header, no samples
+  EXPECT_NE(line.find("speed"), std::string::npos) << line;
+  EXPECT_FALSE(static_cast<bool>(std::getline(h, line)));
 }
 
 }  // namespace

@@ -3,8 +3,9 @@
 master). Checks what one run cannot: the same scene twice gives the same messages; the vehicle
 follows the commanded 1 m/s^2 while torque allows; the nodelet run gives the in-process core
 runner's numbers exactly; a terrain nodelet unloaded from the manager mid-run, or a terrain
-process killed mid-run, stops the run with a clear error instead of a hang; bad input is refused
-with the file and key.
+process killed mid-run, stops the run with a clear error instead of a hang; SIGTERM mid-run ends
+the run at once with an `interrupted` result and a closed bag; bad input is refused with the file
+and key.
 
     python3 test/ros/test_road_runs.py   (after the catkin build; needs the workspace sourced)
 """
@@ -154,6 +155,28 @@ class Failures(unittest.TestCase):
         self.assertEqual(r['status'], 'error')
         self.assertIn('did not answer step', r['error'])
         self.assertLess(time.time() - t0, 30)
+
+    def test_sigterm_mid_run_closes_the_bag_and_the_result_says_interrupted(self):
+        # SIGTERM to roslaunch alone (a scheduler's stop, `kill`): roslaunch stops its nodes with
+        # SIGINT, as Ctrl-C does (test_soil_slope.py sends that one)
+        run = Run(self.tmp, 'sigterm', 'duration:=300')
+        self.wait_for_progress(run)
+        t0 = time.time()
+        os.kill(run.proc.pid, signal.SIGTERM)
+        run.wait(60)
+        # the run stopped at once: its result was written within seconds of the signal (roslaunch
+        # then takes the master down), and says how far it came
+        self.assertLess(os.path.getmtime(run.result_file) - t0, 3.0)
+        r = run.result()
+        self.assertEqual(r['status'], 'interrupted', run.output()[-3000:])
+        self.assertTrue(r['interrupted'])
+        self.assertGreater(r['simulated_time'], 0.0)
+        self.assertLess(r['simulated_time'], 300.0)
+        # the bag is closed (indexed): rosbag info reads it, and it holds the run up to the signal
+        info = subprocess.run(['rosbag', 'info', run.bag], capture_output=True, text=True, env=run.env)
+        self.assertEqual(info.returncode, 0, info.stdout + info.stderr)
+        self.assertNotIn('unindexed', info.stdout + info.stderr)
+        self.assertGreater(len(run.messages([NS + 'odom'])), 10)
 
     def test_bad_grade_is_refused_naming_the_file_and_key(self):
         run = Run(self.tmp, 'bad', 'grade:=95').wait(60)

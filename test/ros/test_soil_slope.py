@@ -11,7 +11,9 @@ preparation dominates):
   draws it, and the topics of rviz/soil_slope.rviz are its topics;
 - the soil on 1 and on 2 threads gives the same bag, message for message (the result message but
   for its wall time);
-- a cone index outside the calibration table is refused naming the terrain file and the key.
+- a cone index outside the calibration table is refused naming the terrain file and the key;
+- Ctrl-C (SIGINT) while the soil is being prepared stops the run at once: an `interrupted` result,
+  a closed bag.
 
 The runs use a copy of the scene at the tiny level, CI 100, in a 6 m box with the soil under the
 wheel tracks only (the copy names its files absolutely).
@@ -21,8 +23,10 @@ wheel tracks only (the copy names its files absolutely).
 import math
 import os
 import shutil
+import signal
 import subprocess
 import tempfile
+import time
 import unittest
 
 import numpy as np
@@ -264,6 +268,38 @@ class BadConeIndex(unittest.TestCase):
             self.assertIn('soil_patch.yaml: cone_index', run.output())
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
+
+
+class Interrupted(unittest.TestCase):
+    def test_sigint_while_the_soil_is_prepared_stops_at_once_and_says_interrupted(self):
+        # Ctrl-C (SIGINT to roslaunch's process group) 4 s after the start: the soil is being
+        # prepared (some 20 s at this level); the preparation stops within a step, the vehicle's
+        # wait for the terrain ends, the result says interrupted and the bag is closed
+        tmp = tempfile.mkdtemp(prefix='dm_soil_sigint_')
+        try:
+            self.stopped_in_the_preparation(tmp)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+    def stopped_in_the_preparation(self, tmp):
+        run = Run(tmp, 'prep_sigint', 'scene:=' + tiny_scene(tmp), 'dem_threads:=1', *SHORT)
+        time.sleep(4.0)
+        self.assertIsNone(run.proc.poll(), run.output()[-3000:])
+        t0 = time.time()
+        os.killpg(run.proc.pid, signal.SIGINT)
+        run.wait(60)
+        self.assertLess(os.path.getmtime(run.result_file) - t0, 3.0)
+        r = run.result()
+        self.assertEqual(r['status'], 'interrupted', run.output()[-3000:])
+        self.assertTrue(r['interrupted'])
+        self.assertEqual(r['simulated_time'], 0.0)
+        self.assertEqual(r['terrain_model'], 'dem_soil')
+        # the reason: the vehicle's wait for the terrain ended by the shutdown, and the terrain's
+        # own (its preparation stopped, in which phase)
+        self.assertIn('shut down while waiting for the terrain', r['error'])
+        self.assertIn('being prepared: phase', r['error'])
+        info = subprocess.run(['rosbag', 'info', run.bag], capture_output=True, text=True, env=run.env)
+        self.assertEqual(info.returncode, 0, info.stdout + info.stderr)
 
 
 if __name__ == '__main__':

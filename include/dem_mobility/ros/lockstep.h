@@ -15,6 +15,7 @@
 // hang, because every wait has a deadline and a left peer closes the channel.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -204,15 +205,27 @@ class ExchangeClient {
     }
     const double timeout = first_ ? timing_.startup_timeout : timing_.peer_timeout;
     RespPtr resp;
-    switch (ch.responses.Take(Seconds(timing_.spin), Seconds(timeout), &resp)) {
-      case Mailbox<Resp>::Wait::kMessage:
-        break;
-      case Mailbox<Resp>::Wait::kClosed:
-        throw ExchangeError("the " + peer_ + " left the exchange at step " + std::to_string(step) + " (" + ch.why() +
-                            ")");
-      case Mailbox<Resp>::Wait::kTimeout:
-        throw ExchangeError("the " + peer_ + " did not answer step " + std::to_string(step) + " within " +
-                            std::to_string(timeout) + " s (is its nodelet loaded and alive?)");
+    // in slices of at most 0.25 s, so that a shutdown (SIGINT) ends a long wait (the first answer
+    // of a soil still being prepared) at once; an answer ends a slice as soon as it is there
+    const auto end = std::chrono::steady_clock::now() + Seconds(timeout);
+    for (bool waiting = true; waiting;) {
+      const auto left = std::max(std::chrono::nanoseconds(0), std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                                                  end - std::chrono::steady_clock::now()));
+      switch (ch.responses.Take(Seconds(timing_.spin), std::min(left, Seconds(0.25)), &resp)) {
+        case Mailbox<Resp>::Wait::kMessage:
+          waiting = false;
+          break;
+        case Mailbox<Resp>::Wait::kClosed:
+          throw ExchangeError("the " + peer_ + " left the exchange at step " + std::to_string(step) + " (" + ch.why() +
+                              ")");
+        case Mailbox<Resp>::Wait::kTimeout:
+          if (std::chrono::steady_clock::now() >= end)
+            throw ExchangeError("the " + peer_ + " did not answer step " + std::to_string(step) + " within " +
+                                std::to_string(timeout) + " s (is its nodelet loaded and alive?)");
+          if (!ros::ok())
+            throw ExchangeError("shut down while waiting for the " + peer_ + "'s answer to step " + std::to_string(step));
+          break;
+      }
     }
     if (resp->step != step)
       throw ExchangeError("the " + peer_ + " answered step " + std::to_string(resp->step) + " to step " +
@@ -243,7 +256,18 @@ class ExchangeClient {
       if (closed)
         throw ExchangeError("the " + peer_ + " left the exchange at step " + std::to_string(step) + " (" + ch.why() +
                             ")");
-      if (std::chrono::steady_clock::now() > end || !ros::ok())
+      if (!ros::ok()) {
+        // a shutdown: the peer, stopped by it too (a soil's preparation), closes the exchange with
+        // its reason within moments; that reason says more than ours
+        const auto grace = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+        while (!ch.requests.closed() && std::chrono::steady_clock::now() < grace)
+          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        if (ch.requests.closed())
+          throw ExchangeError("shut down while waiting for the " + peer_ + "'s answer to step " + std::to_string(step) +
+                              ": " + ch.why());
+        throw ExchangeError("shut down while waiting for the " + peer_ + "'s answer to step " + std::to_string(step));
+      }
+      if (std::chrono::steady_clock::now() > end)
         throw ExchangeError("the " + peer_ + " did not answer step " + std::to_string(step) +
                             " (is its nodelet loaded in this manager?)");
       std::this_thread::sleep_for(std::chrono::milliseconds(1));  // not there yet (still loading)
@@ -260,7 +284,9 @@ class ExchangeClient {
   void WaitForSubscriber() {
     const auto end = std::chrono::steady_clock::now() + Seconds(timing_.startup_timeout);
     while (pub_.getNumSubscribers() == 0 || sub_.getNumPublishers() == 0) {
-      if (std::chrono::steady_clock::now() > end || !ros::ok())
+      if (!ros::ok())
+        throw ExchangeError("shut down while waiting for the " + peer_ + " on topic " + pub_.getTopic());
+      if (std::chrono::steady_clock::now() > end)
         throw ExchangeError("no " + peer_ + " on topic " + pub_.getTopic() + " within " +
                             std::to_string(timing_.startup_timeout) + " s");
       std::this_thread::sleep_for(std::chrono::milliseconds(10));

@@ -4,9 +4,9 @@
 
 namespace dem_mobility::core {
 
-MobilityRun::MobilityRun(const MobilityRunParams& p)
+MobilityRun::MobilityRun(const MobilityRunParams& p, const std::function<bool()>& stop)
     : spec_(VehicleSpec::Load(p.vehicle_file)),
-      terrain_(LoadTerrainModel(p.terrain_file, TerrainVehicleOf(spec_), p.terrain_overrides)),
+      terrain_(LoadTerrainModel(p.terrain_file, TerrainVehicleOf(spec_), p.terrain_overrides, stop)),
       port_(*terrain_),
       driver_(p.driver, spec_),
       sim_(p, spec_) {

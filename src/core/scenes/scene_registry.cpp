@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <memory>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/registry.h"
@@ -38,7 +39,26 @@ class Ticker {
 
 ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) {
   const MobilityRunParams p = MobilityRunParams::Read(reader);
-  MobilityRun run(p);
+  const auto wall0 = std::chrono::steady_clock::now();
+  std::unique_ptr<MobilityRun> made;
+  try {
+    made = std::make_unique<MobilityRun>(p, [s = o.stop] { return s && s->load(std::memory_order_relaxed); });
+  } catch (const Interrupted& e) {
+    // stopped while the terrain prepared, before the run began: the result and the history (its
+    // header) say so, the result with how far the preparation had come
+    MobilityRunResult r;
+    r.interrupted = true;
+    r.terrain = DescribeTerrain(p.terrain_file, p.terrain_overrides);
+    r.terrain_model = r.terrain.model;
+    r.cone_index = r.terrain.cone_index;
+    r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    std::printf("%s\n", e.what());
+    if (!o.history_file.empty()) WriteMobilityHistory(r, o.history_file);
+    ResultFile f = MobilityResultFile(r, p);
+    f.SetStatus("interrupted", e.what());
+    return f;
+  }
+  MobilityRun& run = *made;
   const TimeStepLimit& lim = run.sim().limit();
   std::printf("scene %s: grade %.1f deg, %d bodies, dt %.3g s (critical %.3g s, %s), %.1f s simulated\n",
               p.file.c_str(), p.grade_deg, run.vehicle().system().num_bodies() - 1, run.dt(), lim.dt_crit,

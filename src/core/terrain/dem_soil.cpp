@@ -351,7 +351,8 @@ WheelWrench DemSoilBin::Wrench(int k) const {
 
 // ---------------------------------------------------------------------------------------------
 
-DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels)
+DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels,
+                               const std::function<bool()>& stop)
     : bin_(std::make_unique<DemSoilBin>(p, tire, wheels)) {
   const auto t0 = std::chrono::steady_clock::now();
   description_.file = p.file;
@@ -359,7 +360,15 @@ DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire,
   description_.cone_index = p.ConeIndex();
   description_.time_step = p.level.time_step;
   description_.fidelity = p.level.name;
-  while (!bin_->prepared()) bin_->PrepareStep();
+  while (!bin_->prepared()) {
+    if (stop && stop())
+      throw Interrupted(detail::Concat("interrupted while the soil (", p.file, ", level ", p.level.name, ", ",
+                                       bin_->dem().num_alive(), " particles) was being prepared: phase ", bin_->phase(),
+                                       ", ", bin_->dem().time(), " s of the preparation simulated in ",
+                                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                                       " s"));
+    bin_->PrepareStep();
+  }
   // The vehicle starts with its tires touching the plane z = 0. That plane goes through the top of
   // the highest particle of the bed's interior (a diameter and more from the walls), so that no
   // tire starts inside a particle; the bed's surface (the mean top of its highest particles, from
@@ -529,7 +538,8 @@ void DemSoilTerrain::Advance(double dt) {
   advance_wall_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle) {
+std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
+                                                 const std::function<bool()>& stop) {
   const DemSoilParams p = DemSoilParams::Read(y);
   y.String("model");
   y.Finish();
@@ -567,7 +577,7 @@ std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const Terr
                                        " m): the wheels would meet soil not yet laid; at least ", shortest, " m"));
     }
   }
-  return std::make_unique<DemSoilTerrain>(q, vehicle.tire, vehicle.wheels);
+  return std::make_unique<DemSoilTerrain>(q, vehicle.tire, vehicle.wheels, stop);
 }
 
 TerrainDescription DescribeDemSoilTerrain(const YamlReader& y) {

@@ -15,9 +15,13 @@ namespace dem_mobility::core {
 const std::vector<TerrainKind>& TerrainKinds() {
   static const std::vector<TerrainKind> kinds = {
       {"rigid_road", "a rigid polygonal road (tire vertices against its triangles, asperity friction)",
-       [](const YamlReader& y, const TerrainVehicle& v) { return MakeRoadTerrain(y, v); }, &DescribeRoadTerrain},
+       [](const YamlReader& y, const TerrainVehicle& v, const std::function<bool()>&) { return MakeRoadTerrain(y, v); },
+       &DescribeRoadTerrain},
       {"dem_soil", "a DEM soil bin (cohesive particles, prepared under a lid) the tires sink into",
-       [](const YamlReader& y, const TerrainVehicle& v) { return MakeDemSoilTerrain(y, v); }, &DescribeDemSoilTerrain},
+       [](const YamlReader& y, const TerrainVehicle& v, const std::function<bool()>& stop) {
+         return MakeDemSoilTerrain(y, v, stop);
+       },
+       &DescribeDemSoilTerrain},
   };
   return kinds;
 }
@@ -39,9 +43,9 @@ const TerrainKind& FindTerrainKind(const YamlReader& y) {
 }  // namespace
 
 std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
-                                               const std::vector<std::string>& overrides) {
+                                               const std::vector<std::string>& overrides, const std::function<bool()>& stop) {
   const YamlReader y = YamlReader::LoadWithOverrides(terrain_file, overrides);
-  return FindTerrainKind(y).make(y, vehicle);
+  return FindTerrainKind(y).make(y, vehicle, stop);
 }
 
 TerrainDescription DescribeTerrain(const std::string& terrain_file, const std::vector<std::string>& overrides) {

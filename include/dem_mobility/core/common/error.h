@@ -19,6 +19,13 @@ class SimulationError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A run stopped from outside (SIGINT, SIGTERM, a ROS shutdown) before it began to step: during a
+/// long preparation (a DEM soil's pour, lid and settling). Its text says what was reached.
+class Interrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 namespace detail {
 template <typename... Args>
 std::string Concat(const Args&... args) {

@@ -2,6 +2,7 @@
 // directly, through the same loop the nodelets run (cosim/cosim_loop.h).
 #pragma once
 
+#include <functional>
 #include <memory>
 
 #include "dem_mobility/core/cosim/cosim_loop.h"
@@ -12,8 +13,9 @@ namespace dem_mobility::core {
 class MobilityRun {
  public:
   /// Builds the terrain, the driver and the vehicle, and makes the opening exchange (ConfigError
-  /// for bad input or a time step above the limit).
-  explicit MobilityRun(const MobilityRunParams& p);
+  /// for bad input or a time step above the limit). `stop` (may be empty) is called while the
+  /// terrain prepares: once it returns true, Interrupted says where the preparation was.
+  explicit MobilityRun(const MobilityRunParams& p, const std::function<bool()>& stop = {});
   /// The same on a terrain built already (e.g. a copy of a prepared soil: one preparation, many runs).
   MobilityRun(const MobilityRunParams& p, std::unique_ptr<TerrainModel> terrain);
   MobilityRunResult Run(CoSimObserver* observer = nullptr);

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -170,7 +171,9 @@ class SoilPatch;
 /// exactly minus the one the particles received.
 class DemSoilTerrain final : public TerrainModel {
  public:
-  DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels);
+  /// Prepares the soil (pour, lid, settling); `stop` (may be empty) is called every step of it:
+  /// once it returns true, Interrupted names the phase and the simulated time reached.
+  DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels, const std::function<bool()>& stop = {});
   /// A copy (its own particles, walls and patch): one prepared soil serves several runs.
   DemSoilTerrain(const DemSoilTerrain& o);
   DemSoilTerrain& operator=(const DemSoilTerrain&) = delete;
@@ -206,7 +209,8 @@ class DemSoilTerrain final : public TerrainModel {
   std::vector<WheelWrench> wrenches_;
 };
 
-std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle);
+std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
+                                                 const std::function<bool()>& stop = {});
 TerrainDescription DescribeDemSoilTerrain(const YamlReader& y);
 
 }  // namespace dem_mobility::core

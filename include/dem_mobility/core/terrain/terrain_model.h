@@ -80,7 +80,10 @@ TerrainVehicle TerrainVehicleOf(const VehicleSpec& spec);
 struct TerrainKind {
   std::string model;
   std::string what;  ///< one line for messages and listings
-  std::function<std::unique_ptr<TerrainModel>(const YamlReader& file, const TerrainVehicle& vehicle)> make;
+  /// `stop` (may be empty): called during a long preparation; true throws Interrupted.
+  std::function<std::unique_ptr<TerrainModel>(const YamlReader& file, const TerrainVehicle& vehicle,
+                                              const std::function<bool()>& stop)>
+      make;
   std::function<TerrainDescription(const YamlReader& file)> describe;
 };
 
@@ -89,9 +92,12 @@ const std::vector<TerrainKind>& TerrainKinds();
 
 /// Builds the terrain described by `terrain_file` (with `key=value` overrides, a scene's
 /// terrain_overrides) for the wheels of `vehicle`. Throws ConfigError naming file and key of bad
-/// input (an unknown `model:` lists the known ones).
+/// input (an unknown `model:` lists the known ones). `stop` (may be empty) is called while the
+/// terrain prepares (a DEM soil: every step of its pour, lid and settling): once it returns true,
+/// the preparation stops within a step and Interrupted says where it was.
 std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
-                                               const std::vector<std::string>& overrides = {});
+                                               const std::vector<std::string>& overrides = {},
+                                               const std::function<bool()>& stop = {});
 /// What `terrain_file` describes (model, cone index, time step, level), without building it.
 TerrainDescription DescribeTerrain(const std::string& terrain_file, const std::vector<std::string>& overrides = {});
 
