@@ -3,16 +3,23 @@
 // the bag is written in simulation-time order (each message's header stamp is its record time;
 // ties go by the order of ~topics), so the same run gives the same bag. When the end topic (the
 // mobility result) arrives, everything is flushed, the bag is closed and, if asked, the run ends.
+// A bag that cannot be written (a full disk, a file size limit) is an error said at once: on the
+// latched topic recorder/error (std_msgs/String; the vehicle and the rigs stop their run with it)
+// and in the log; the process ignores SIGXFSZ, so a size limit fails the write instead of killing
+// the manager with every nodelet in it.
 #include <algorithm>
+#include <csignal>
 #include <cstring>
 #include <deque>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <sstream>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <rosbag/bag.h>
+#include <std_msgs/String.h>
 #include <topic_tools/shape_shifter.h>
 
 namespace dem_mobility {
@@ -96,10 +103,13 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     pnh.getParam("latched_topics", latched);
     pnh.param<std::string>("end_topic", end, "");
     pnh.param("shutdown_when_done", shutdown_when_done_, false);
+    // a file size limit (ulimit -f) fails the bag's writes (EFBIG) instead of killing the process
+    std::signal(SIGXFSZ, SIG_IGN);
+    error_ = nh.advertise<std_msgs::String>("recorder/error", 1, true);
     try {
       const std::filesystem::path parent = std::filesystem::path(path_).parent_path();
       if (!parent.empty()) std::filesystem::create_directories(parent);
-      bag_.open(path_, rosbag::bagmode::Write);
+      bag_->open(path_, rosbag::bagmode::Write);
     } catch (const std::exception& e) {
       return Fatal("parameter " + pnh.resolveName("bag") + ": cannot write the bag '" + path_ + "': " + e.what());
     }
@@ -132,7 +142,11 @@ class BagRecorderNodelet : public nodelet::Nodelet {
 
   void OnMessage(size_t index, const ros::MessageEvent<topic_tools::ShapeShifter const>& event) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!open_) return;
+    if (!open_) {
+      // a bag that failed still ends the run when asked, once the result (which carries the error) is out
+      if (failed_ && static_cast<int>(index) == end_index_ && shutdown_when_done_) ros::requestShutdown();
+      return;
+    }
     Topic& t = topics_[index];
     const auto& msg = event.getConstMessage();
     if (t.stamp_offset == -2) t.stamp_offset = StampOffset(msg->getMessageDefinition());
@@ -179,7 +193,30 @@ class BagRecorderNodelet : public nodelet::Nodelet {
       if (!s.seen) return;
       safe = std::min(safe, s.latest);
     }
-    if (any_stream) Write(safe);
+    if (any_stream) WriteOrFail(safe);
+  }
+
+  /// Write, and on failure (the disk full, the file size limit, an I/O error) the error said on
+  /// recorder/error and in the log; nothing more is recorded.
+  void WriteOrFail(const ros::Time& limit) {
+    try {
+      Write(limit);
+    } catch (const std::exception& e) {
+      Failed(e.what());
+    }
+  }
+
+  /// The bag cannot be written: said, and the bag let go. (rosbag::Bag closes itself in its
+  /// destructor, which throws when the index cannot be written either: the object is left
+  /// behind, its file descriptor to the process's end.)
+  void Failed(const std::string& what) {
+    open_ = false;
+    failed_ = true;
+    std_msgs::String m;
+    m.data = "the bag recorder cannot write " + path_ + " (disk full or a file size limit?): " + what;
+    NODELET_FATAL("%s", m.data.c_str());
+    error_.publish(m);
+    (void)bag_.release();
   }
 
   /// Writes every queued message stamped before `limit`, oldest first (ties in topic order).
@@ -196,7 +233,7 @@ class BagRecorderNodelet : public nodelet::Nodelet {
       topics_[best].queue.pop_front();
       // rosbag refuses record times below TIME_MIN (the stamp 0 of the first messages)
       const ros::Time record = std::max(p.stamp, ros::TIME_MIN);
-      bag_.write(topics_[best].name, record, *p.msg, p.header);
+      bag_->write(topics_[best].name, record, *p.msg, p.header);
       last_written_ = std::max(last_written_, p.stamp);
     }
   }
@@ -206,9 +243,9 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     open_ = false;
     try {
       Write(ros::TIME_MAX);
-      bag_.close();
+      bag_->close();
     } catch (const std::exception& e) {
-      NODELET_ERROR("bag %s: %s", path_.c_str(), e.what());
+      Failed(e.what());
       return;
     }
     std::ostringstream counts;
@@ -219,8 +256,9 @@ class BagRecorderNodelet : public nodelet::Nodelet {
 
   std::mutex mutex_;
   std::string path_;
-  rosbag::Bag bag_;
-  bool open_ = false, shutdown_when_done_ = false;
+  std::unique_ptr<rosbag::Bag> bag_ = std::make_unique<rosbag::Bag>();
+  ros::Publisher error_;
+  bool open_ = false, failed_ = false, shutdown_when_done_ = false;
   std::vector<Topic> topics_;
   int end_index_ = -1;
   ros::Time last_written_;

@@ -42,6 +42,9 @@ int main(int argc, char** argv) {
   options.stop = &g_stop;
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
+  // a file size limit (ulimit -f) fails a write with an error instead of killing the process, so
+  // that the result says what failed
+  std::signal(SIGXFSZ, SIG_IGN);
   std::vector<std::string> overrides;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];

@@ -218,6 +218,31 @@ TEST(Config, RunnerInterruptedKeepsTheRunsResult) {
   EXPECT_GT(lines, 10);  // the samples so far (100 Hz)
 }
 
+TEST(Config, RunnerOnAFullDiskSaysSoAndKeepsTheResult) {
+  // a road run whose history outgrows a file size limit (prlimit --fsize: as a full disk does): the
+  // history's write fails, the result (small) says so naming the file, and the exit status is 3
+  const fs::path dir = fs::temp_directory_path() / "dm_runner_full_disk";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string result = (dir / "r.yaml").string(), history = (dir / "h.csv").string();
+  const std::string cmd = "prlimit --fsize=20000 " + std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR
+                          "/scenes/road_slope.yaml duration=3 --quiet --out " + result + " --history " + history +
+                          " > /dev/null 2> " + (dir / "err.txt").string();
+  const int rc = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(rc));
+  EXPECT_EQ(WEXITSTATUS(rc), 3);
+  EXPECT_LE(fs::file_size(history), 20000u);
+  const YAML::Node r = YAML::LoadFile(result);
+  EXPECT_EQ(r["status"].as<std::string>(), "error");
+  const std::string why = r["error"].as<std::string>();
+  EXPECT_NE(why.find(history + ": writing the history file failed"), std::string::npos) << why;
+  EXPECT_GT(r["simulated_time"].as<double>(), 2.9);  // the run itself was made and is reported
+  std::ifstream err(dir / "err.txt");
+  std::stringstream ss;
+  ss << err.rdbuf();
+  EXPECT_NE(ss.str().find("simulation error"), std::string::npos) << ss.str();
+}
+
 TEST(Config, RunnerInterruptedWhileTheSoilIsPreparedStopsWithinASecond) {
   // a soil scene (the tiny level: its preparation takes some 15-35 s here) sent SIGTERM 1 s after
   // its start, in the soil's preparation: it stops within a second of the signal (the preparation

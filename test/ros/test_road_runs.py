@@ -4,7 +4,8 @@ master). Checks what one run cannot: the same scene twice gives the same message
 follows the commanded 1 m/s^2 while torque allows; the nodelet run gives the in-process core
 runner's numbers exactly; a terrain nodelet unloaded from the manager mid-run, or a terrain
 process killed mid-run, stops the run with a clear error instead of a hang; SIGTERM mid-run ends
-the run at once with an `interrupted` result and a closed bag; bad input is refused with the file
+the run at once with an `interrupted` result and a closed bag; a bag that cannot be written (a
+file size limit, as a full disk) stops the run with that error; bad input is refused with the file
 and key.
 
     python3 test/ros/test_road_runs.py   (after the catkin build; needs the workspace sourced)
@@ -33,8 +34,8 @@ class Run(LaunchRun):
     """One roslaunch of road_slope.launch (or `launch`) with its own master, in its own folder; its
     messages are compared raw."""
 
-    def __init__(self, tmp, name, *args, launch='road_slope.launch'):
-        super().__init__(tmp, name, launch, *args)
+    def __init__(self, tmp, name, *args, launch='road_slope.launch', prefix=()):
+        super().__init__(tmp, name, launch, *args, prefix=prefix)
 
     def messages(self, topics=None):
         return super().messages(topics, raw=True)
@@ -177,6 +178,19 @@ class Failures(unittest.TestCase):
         self.assertEqual(info.returncode, 0, info.stdout + info.stderr)
         self.assertNotIn('unindexed', info.stdout + info.stderr)
         self.assertGreater(len(run.messages([NS + 'odom'])), 10)
+
+    def test_a_bag_that_cannot_be_written_stops_the_run_with_an_error(self):
+        # a file size limit of 3 MB (as a full disk): the bag's writes fail once it is reached; the
+        # recorder says so, the vehicle stops the run with that error and the result says it
+        # (before, SIGXFSZ killed the manager: an unindexed bag, an empty result file)
+        run = Run(self.tmp, 'full', 'duration:=60', prefix=['prlimit', '--fsize=3000000']).wait(60)
+        self.assertLessEqual(os.path.getsize(run.bag), 3000000)
+        r = run.result()
+        self.assertEqual(r['status'], 'error', run.output()[-3000:])
+        self.assertIn('the bag recorder cannot write ' + run.bag, r['error'])
+        self.assertIn('disk full or a file size limit', r['error'])
+        self.assertLess(r['simulated_time'], 60.0)
+        self.assertIn('the bag recorder cannot write', run.output())
 
     def test_bad_grade_is_refused_naming_the_file_and_key(self):
         run = Run(self.tmp, 'bad', 'grade:=95').wait(60)

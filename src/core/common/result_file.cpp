@@ -67,7 +67,8 @@ void ResultFile::Write(const std::string& path) const {
   std::ofstream out(path);
   if (!out) throw ConfigError(path + ": cannot write the result file");
   out << Text();
-  if (!out) throw ConfigError(path + ": writing the result file failed");
+  out.flush();
+  if (!out) throw ConfigError(path + ": writing the result file failed (disk full or a file size limit?)");
 }
 
 void ResultFile::CheckWritable(const std::string& path, const std::string& what) {

@@ -216,6 +216,8 @@ void WriteMobilityHistory(const MobilityRunResult& r, const std::string& path) {
     for (double v : s.sinkage) out << "," << v;
     out << "\n";
   }
+  out.flush();
+  if (!out) throw ConfigError(path + ": writing the history file failed (disk full or a file size limit?)");
 }
 
 }  // namespace dem_mobility::core
