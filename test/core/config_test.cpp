@@ -192,26 +192,45 @@ TEST(Config, SceneTerrainOverridesTakeNestedKeysAsDottedOnes) {
   }
 }
 
+/// A run of dm_run_scene in a fresh folder of its own: `prefix` before the runner (timeout, prlimit),
+/// `args` after the scene file; the result, the history, stdout and stderr go into the folder.
+struct RunnerRun {
+  fs::path dir;
+  std::string result, history;
+  int rc = -1;
+  double wall = 0.0;  ///< [s] the whole command
+  RunnerRun(const std::string& name, const std::string& prefix, const std::string& scene, const std::string& args)
+      : dir(fs::temp_directory_path() / name), result((dir / "r.yaml").string()), history((dir / "h.csv").string()) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string cmd = prefix + " " + std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR "/scenes/" + scene + " " +
+                            args + " --quiet --out " + result + " --history " + history + " > " +
+                            (dir / "out.txt").string() + " 2> " + (dir / "err.txt").string();
+    const auto t0 = std::chrono::steady_clock::now();
+    rc = std::system(cmd.c_str());
+    wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  std::string Err() const {
+    std::ifstream in(dir / "err.txt");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+};
+
 TEST(Config, RunnerInterruptedKeepsTheRunsResult) {
   // a 40 s road run sent SIGTERM after 3 s: it ends at the next step, writes its result (status
   // interrupted, the simulated time so far) and history, and exits 4
-  const fs::path dir = fs::temp_directory_path() / "dm_runner_interrupt";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string result = (dir / "r.yaml").string(), history = (dir / "h.csv").string();
-  const std::string cmd = "timeout --preserve-status -s TERM 3 " + std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR
-                          "/scenes/road_slope.yaml duration=40 --quiet --out " + result + " --history " + history +
-                          " 2> " + (dir / "err.txt").string();
-  const int rc = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(rc));
-  EXPECT_EQ(WEXITSTATUS(rc), 4);
-  const YAML::Node r = YAML::LoadFile(result);
+  const RunnerRun run("dm_runner_interrupt", "timeout --preserve-status -s TERM 3", "road_slope.yaml", "duration=40");
+  ASSERT_TRUE(WIFEXITED(run.rc));
+  EXPECT_EQ(WEXITSTATUS(run.rc), 4);
+  const YAML::Node r = YAML::LoadFile(run.result);
   EXPECT_EQ(r["status"].as<std::string>(), "interrupted");
   EXPECT_TRUE(r["interrupted"].as<bool>());
   const double t = r["simulated_time"].as<double>();
   EXPECT_GT(t, 0.0);
   EXPECT_LT(t, 40.0);
-  std::ifstream h(history);
+  std::ifstream h(run.history);
   std::string line;
   long lines = 0;
   while (std::getline(h, line)) ++lines;
@@ -221,26 +240,16 @@ TEST(Config, RunnerInterruptedKeepsTheRunsResult) {
 TEST(Config, RunnerOnAFullDiskSaysSoAndKeepsTheResult) {
   // a road run whose history outgrows a file size limit (prlimit --fsize: as a full disk does): the
   // history's write fails, the result (small) says so naming the file, and the exit status is 3
-  const fs::path dir = fs::temp_directory_path() / "dm_runner_full_disk";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string result = (dir / "r.yaml").string(), history = (dir / "h.csv").string();
-  const std::string cmd = "prlimit --fsize=20000 " + std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR
-                          "/scenes/road_slope.yaml duration=3 --quiet --out " + result + " --history " + history +
-                          " > /dev/null 2> " + (dir / "err.txt").string();
-  const int rc = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(rc));
-  EXPECT_EQ(WEXITSTATUS(rc), 3);
-  EXPECT_LE(fs::file_size(history), 20000u);
-  const YAML::Node r = YAML::LoadFile(result);
+  const RunnerRun run("dm_runner_full_disk", "prlimit --fsize=20000", "road_slope.yaml", "duration=3");
+  ASSERT_TRUE(WIFEXITED(run.rc));
+  EXPECT_EQ(WEXITSTATUS(run.rc), 3);
+  EXPECT_LE(fs::file_size(run.history), 20000u);
+  const YAML::Node r = YAML::LoadFile(run.result);
   EXPECT_EQ(r["status"].as<std::string>(), "error");
   const std::string why = r["error"].as<std::string>();
-  EXPECT_NE(why.find(history + ": writing the history file failed"), std::string::npos) << why;
+  EXPECT_NE(why.find(run.history + ": writing the history file failed"), std::string::npos) << why;
   EXPECT_GT(r["simulated_time"].as<double>(), 2.9);  // the run itself was made and is reported
-  std::ifstream err(dir / "err.txt");
-  std::stringstream ss;
-  ss << err.rdbuf();
-  EXPECT_NE(ss.str().find("simulation error"), std::string::npos) << ss.str();
+  EXPECT_NE(run.Err().find("simulation error"), std::string::npos) << run.Err();
 }
 
 TEST(Config, RunnerInterruptedWhileTheSoilIsPreparedStopsWithinASecond) {
@@ -248,21 +257,12 @@ TEST(Config, RunnerInterruptedWhileTheSoilIsPreparedStopsWithinASecond) {
   // its start, in the soil's preparation: it stops within a second of the signal (the preparation
   // polls the stop at every step), writes its result (status interrupted, the phase reached) and
   // the history's header, and exits 4
-  const fs::path dir = fs::temp_directory_path() / "dm_runner_interrupt_prep";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string result = (dir / "r.yaml").string(), history = (dir / "h.csv").string();
-  const std::string cmd = "timeout --preserve-status -s TERM 1 " + std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR
-                          "/scenes/soil_slope.yaml terrain_overrides.fidelity=tiny terrain_overrides.threads=1 "
-                          "--quiet --out " + result + " --history " + history + " > " + (dir / "out.txt").string() +
-                          " 2> " + (dir / "err.txt").string();
-  const auto t0 = std::chrono::steady_clock::now();
-  const int rc = std::system(cmd.c_str());
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  ASSERT_TRUE(WIFEXITED(rc));
-  EXPECT_EQ(WEXITSTATUS(rc), 4);
-  EXPECT_LT(wall, 2.0);  // 1 s to the signal, then within a second
-  const YAML::Node r = YAML::LoadFile(result);
+  const RunnerRun run("dm_runner_interrupt_prep", "timeout --preserve-status -s TERM 1", "soil_slope.yaml",
+                      "terrain_overrides.fidelity=tiny terrain_overrides.threads=1");
+  ASSERT_TRUE(WIFEXITED(run.rc));
+  EXPECT_EQ(WEXITSTATUS(run.rc), 4);
+  EXPECT_LT(run.wall, 2.0);  // 1 s to the signal, then within a second
+  const YAML::Node r = YAML::LoadFile(run.result);
   EXPECT_EQ(r["status"].as<std::string>(), "interrupted");
   EXPECT_TRUE(r["interrupted"].as<bool>());
   const std::string why = r["error"].as<std::string>();
@@ -271,7 +271,7 @@ TEST(Config, RunnerInterruptedWhileTheSoilIsPreparedStopsWithinASecond) {
   EXPECT_EQ(r["terrain_model"].as<std::string>(), "dem_soil");
   EXPECT_EQ(r["fidelity"].as<std::string>(), "tiny");
   EXPECT_EQ(r["simulated_time"].as<double>(), 0.0);
-  std::ifstream h(history);
+  std::ifstream h(run.history);
   std::string line;
   ASSERT_TRUE(static_cast<bool>(std::getline(h, line)));  // the header, no samples
   EXPECT_NE(line.find("speed"), std::string::npos) << line;

@@ -5,6 +5,7 @@ import os
 import signal
 import socket
 import subprocess
+import time
 
 import rosbag
 import yaml
@@ -45,6 +46,23 @@ class LaunchRun:
         finally:
             self.log.close()
         return self
+
+    def stop(self, sig, group=True, timeout=60):
+        """Sends `sig` to roslaunch's process group (as Ctrl-C does) or, `group` false, to roslaunch
+        alone, and waits for the end; returns the seconds from the signal to the result file's last
+        write (the run's own stop, before roslaunch takes the master down)."""
+        t0 = time.time()
+        if group:
+            os.killpg(self.proc.pid, sig)
+        else:
+            os.kill(self.proc.pid, sig)
+        self.wait(timeout)
+        return os.path.getmtime(self.result_file) - t0
+
+    def bag_info(self):
+        """`rosbag info` of the bag: (return code, its output); a bag left open says 'unindexed'."""
+        p = subprocess.run(['rosbag', 'info', self.bag], capture_output=True, text=True, env=self.env)
+        return p.returncode, p.stdout + p.stderr
 
     @property
     def returncode(self):
