@@ -20,9 +20,10 @@ def free_port():
 class LaunchRun:
     """`roslaunch dem_mobility LAUNCH bag:=DIR/run.bag ARGS...` in DIR = tmp/name; the run's result
     YAML is the bag's name with .result.yaml. `env` adds to the environment; `prefix` goes before
-    roslaunch on its command line (e.g. prlimit and its limits)."""
+    roslaunch on its command line (e.g. prlimit and its limits); `program`: roslaunch, or
+    scripts/dm_launch (roslaunch with the run's exit status)."""
 
-    def __init__(self, tmp, name, launch, *args, env=None, prefix=()):
+    def __init__(self, tmp, name, launch, *args, env=None, prefix=(), program='roslaunch'):
         self.dir = os.path.join(tmp, name)
         os.makedirs(self.dir)
         self.bag = os.path.join(self.dir, 'run.bag')
@@ -31,7 +32,7 @@ class LaunchRun:
         self.env = dict(os.environ, ROS_HOME=self.dir, ROS_MASTER_URI='http://localhost:%d' % self.port,
                         **(env or {}))
         self.log = open(os.path.join(self.dir, 'roslaunch.log'), 'w')
-        self.proc = subprocess.Popen(list(prefix) + ['roslaunch', '-p', str(self.port), 'dem_mobility', launch,
+        self.proc = subprocess.Popen(list(prefix) + [program, '-p', str(self.port), 'dem_mobility', launch,
                                       'bag:=' + self.bag] + list(args),
                                      stdout=self.log, stderr=subprocess.STDOUT, env=self.env,
                                      start_new_session=True)
