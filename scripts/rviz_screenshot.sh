@@ -15,7 +15,7 @@ case "$launch_file" in
   replay.launch) extra=() ;;
   *) extra=(rviz:=true) ;;
 esac
-ensure_packages "${DM_ROS_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
+ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
 build_catkin >/dev/null
 ros_env
 display=":$(( 90 + RANDOM % 9 ))"
