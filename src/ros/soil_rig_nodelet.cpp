@@ -5,20 +5,19 @@
 // file. No physics here: the core computes, the nodelet converts and publishes.
 #include <atomic>
 #include <chrono>
-#include <mutex>
 #include <thread>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/PointCloud2.h>
-#include <std_msgs/String.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/ros/conversions.h"
 #include "dem_mobility/ros/dem_visuals.h"
+#include "dem_mobility/ros/recorder_watch.h"
 #include "dem_mobility/ros/rig_topics.h"
 #include "dem_mobility/ros/core_names.h"
 
@@ -77,14 +76,7 @@ class SoilRigNodelet : public nodelet::Nodelet {
     }
     NODELET_INFO("soil rig '%s' from %s: %d particles", rig_->kind(), scene_file_.c_str(), rig_->dem().num_alive());
     // the bag recorder's failure (a full disk, a file size limit) ends the run with its error
-    recorder_error_sub_ = getNodeHandle().subscribe<std_msgs::String>(
-        "recorder/error", 1, [this](const std_msgs::String::ConstPtr& m) {
-          {
-            std::lock_guard<std::mutex> lock(recorder_mutex_);
-            recorder_error_ = m->data;
-          }
-          recorder_failed_ = true;
-        });
+    recorder_.Start(getNodeHandle());
     thread_ = std::thread([this] { Run(); });
   }
 
@@ -113,9 +105,8 @@ class SoilRigNodelet : public nodelet::Nodelet {
     auto next_progress = wall0 + std::chrono::seconds(10);
     try {
       while (!rig_->done()) {
-        if (recorder_failed_) {
-          std::lock_guard<std::mutex> lock(recorder_mutex_);
-          rig_->Fail(recorder_error_);
+        if (recorder_.failed()) {
+          rig_->Fail(recorder_.error());
           break;
         }
         if (stop_ || !ros::ok()) {
@@ -218,10 +209,7 @@ class SoilRigNodelet : public nodelet::Nodelet {
   std::string scene_file_, frame_id_, result_file_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
-  ros::Subscriber recorder_error_sub_;
-  std::mutex recorder_mutex_;
-  std::string recorder_error_;  ///< the bag recorder's failure (recorder/error), under recorder_mutex_
-  std::atomic<bool> recorder_failed_{false};
+  RecorderWatch recorder_;  ///< the bag recorder's failure ends the run with its error
   ros::Publisher clock_, markers_, tools_, cloud_, section_;
   double cloud_rate_ = 20.0, clock_rate_ = 100.0;
   bool wait_for_recorder_ = true;

@@ -9,14 +9,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <mutex>
 #include <thread>
 
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <rosgraph_msgs/Clock.h>
-#include <std_msgs/String.h>
 #include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -29,6 +27,7 @@
 #include "dem_mobility/ros/conversions.h"
 #include "dem_mobility/ros/vehicle_visuals.h"
 #include "dem_mobility/ros/core_names.h"
+#include "dem_mobility/ros/recorder_watch.h"
 
 namespace dem_mobility {
 namespace {
@@ -163,13 +162,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     }
     Advertise(nh);
     // the bag recorder's failure (a full disk, a file size limit) ends the run with its error
-    recorder_error_sub_ = nh.subscribe<std_msgs::String>("recorder/error", 1, [this](const std_msgs::String::ConstPtr& m) {
-      {
-        std::lock_guard<std::mutex> lock(recorder_mutex_);
-        recorder_error_ = m->data;
-      }
-      recorder_failed_ = true;
-    });
+    recorder_.Start(nh);
     thread_ = std::thread([this] { Run(); });
   }
 
@@ -205,7 +198,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       if (std::chrono::steady_clock::now() > end)
         throw ConfigError("no recorder subscribed to the logged topics within 60 s (set ~wait_for_recorder false "
                           "to run without one)");
-      if (recorder_failed_) throw ConfigError(RecorderError());
+      if (recorder_.failed()) throw ConfigError(recorder_.error());
       if (stop_ || !ros::ok()) throw ConfigError("stopped while waiting for the recorder");
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
@@ -230,9 +223,9 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
                    scene_.settle_time);
       wall0_ = std::chrono::steady_clock::now();
       r = RunCoSimulation(*sim_, *terrain_, *driver_, this);
-      if (recorder_failed_) {  // the loop stopped for it: an error, not an interruption
+      if (recorder_.failed()) {  // the loop stopped for it: an error, not an interruption
         r.interrupted = false;
-        r.error = RecorderError();
+        r.error = recorder_.error();
       } else if (!r.error.empty() && ShuttingDown()) {
         // a peer gone in a shutdown (roslaunch stops the nodelet loaders first, and each unloads
         // its nodelet): the run was interrupted, the peer's leaving is its reason
@@ -241,8 +234,8 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
         r.error.clear();
       }
     } catch (const std::exception& e) {  // configuration errors (time step) before the first step
-      if (recorder_failed_) {
-        r.error = RecorderError();
+      if (recorder_.failed()) {
+        r.error = recorder_.error();
       } else if (ShuttingDown()) {
         // a shutdown before the run began (e.g. while the soil was being prepared): interrupted,
         // with the reason the exchange gave
@@ -276,7 +269,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     if (k % log_every_ == 0) Log(sim);
     if ((k & 255) == 0) Progress(sim);
   }
-  bool StopRequested() override { return stop_.load() || recorder_failed_.load() || !ros::ok(); }
+  bool StopRequested() override { return stop_.load() || recorder_.failed() || !ros::ok(); }
 
   /// True when this nodelet or the process is being shut down, or is within `grace` seconds (a
   /// peer that left may have left for a shutdown that reaches this nodelet moments later).
@@ -287,11 +280,6 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       if (std::chrono::steady_clock::now() >= end) return false;
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
-  }
-
-  std::string RecorderError() {
-    std::lock_guard<std::mutex> lock(recorder_mutex_);
-    return recorder_error_;
   }
 
   void Pace(double t_sim) {
@@ -453,10 +441,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   std::unique_ptr<ExchangeDriverPort> driver_;
   std::string world_frame_, map_frame_, base_frame_, result_file_;
   std::string interrupted_why_;  ///< why a run was interrupted before it began (the exchange's reason)
-  ros::Subscriber recorder_error_sub_;
-  std::mutex recorder_mutex_;
-  std::string recorder_error_;  ///< the bag recorder's failure (recorder/error), under recorder_mutex_
-  std::atomic<bool> recorder_failed_{false};
+  RecorderWatch recorder_;  ///< the bag recorder's failure ends the run with its error
   double log_rate_ = 100.0, clock_rate_ = 100.0, max_rtf_ = 0.0, force_scale_ = 1e-4;
   bool wait_for_recorder_ = true, shutdown_when_done_ = false;
   long log_every_ = 1, clock_every_ = 1;

@@ -206,27 +206,23 @@ class ExchangeClient {
     const double timeout = first_ ? timing_.startup_timeout : timing_.peer_timeout;
     RespPtr resp;
     // in slices of at most 0.25 s, so that a shutdown (SIGINT) ends a long wait (the first answer
-    // of a soil still being prepared) at once; an answer ends a slice as soon as it is there
-    const auto end = std::chrono::steady_clock::now() + Seconds(timeout);
-    for (bool waiting = true; waiting;) {
-      const auto left = std::max(std::chrono::nanoseconds(0), std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                                                  end - std::chrono::steady_clock::now()));
-      switch (ch.responses.Take(Seconds(timing_.spin), std::min(left, Seconds(0.25)), &resp)) {
-        case Mailbox<Resp>::Wait::kMessage:
-          waiting = false;
-          break;
-        case Mailbox<Resp>::Wait::kClosed:
-          throw ExchangeError("the " + peer_ + " left the exchange at step " + std::to_string(step) + " (" + ch.why() +
-                              ")");
-        case Mailbox<Resp>::Wait::kTimeout:
-          if (std::chrono::steady_clock::now() >= end)
-            throw ExchangeError("the " + peer_ + " did not answer step " + std::to_string(step) + " within " +
-                                std::to_string(timeout) + " s (is its nodelet loaded and alive?)");
-          if (!ros::ok())
-            throw ExchangeError("shut down while waiting for the " + peer_ + "'s answer to step " + std::to_string(step));
-          break;
-      }
+    // of a soil still being prepared) at once; an answer ends a slice as soon as it is there, and
+    // the usual exchange (answered in the first slice) reads no clock
+    const std::chrono::nanoseconds whole = Seconds(timeout), slice = std::min(whole, Seconds(0.25));
+    std::chrono::nanoseconds waited = slice;
+    typename Mailbox<Resp>::Wait w = ch.responses.Take(Seconds(timing_.spin), slice, &resp);
+    while (w == Mailbox<Resp>::Wait::kTimeout && waited < whole) {
+      if (!ros::ok())
+        throw ExchangeError("shut down while waiting for the " + peer_ + "'s answer to step " + std::to_string(step));
+      const std::chrono::nanoseconds next = std::min(slice, whole - waited);
+      w = ch.responses.Take(Seconds(timing_.spin), next, &resp);
+      waited += next;
     }
+    if (w == Mailbox<Resp>::Wait::kClosed)
+      throw ExchangeError("the " + peer_ + " left the exchange at step " + std::to_string(step) + " (" + ch.why() + ")");
+    if (w == Mailbox<Resp>::Wait::kTimeout)
+      throw ExchangeError("the " + peer_ + " did not answer step " + std::to_string(step) + " within " +
+                          std::to_string(timeout) + " s (is its nodelet loaded and alive?)");
     if (resp->step != step)
       throw ExchangeError("the " + peer_ + " answered step " + std::to_string(resp->step) + " to step " +
                           std::to_string(step) + ": the lock-step order is broken");
