@@ -53,7 +53,7 @@ else:
 if r.get('terrain_model') == 'dem_soil':
     ci = r.get('cone_index_psi')
     print('soil: level %s, cone index %s, f %s; slip %s, sinkage %s m, drawbar margin %.3f' % (
-        r.get('fidelity'), '%.4g psi' % ci if isinstance(ci, float) else 'unknown', r.get('cohesion_factor'),
+        r.get('fidelity'), '%.4g psi' % ci if isinstance(ci, (int, float)) and ci == ci else 'unknown', r.get('cohesion_factor'),
         ' '.join('%.3f' % s for s in r['slip']), ' '.join('%.3f' % s for s in r['sinkage']), r['drawbar_margin']))
 EOF
 echo "plot: python3 scripts/plot_speed.py $bag"
