@@ -277,6 +277,13 @@ class Sweep:
         o.returncode = o.proc.returncode
         if o.timed_out:
             o.error = 'timed out after %.0f s' % (o.end - o.start)
+        elif o.returncode is not None and o.returncode < 0:
+            # killed from outside (SIGKILL, the OOM killer, ...): whatever result it left is not a whole run's
+            try:
+                name = signal.Signals(-o.returncode).name
+            except ValueError:
+                name = 'signal %d' % -o.returncode
+            o.error = 'killed by %s mid-case; see %s' % (name, o.log)
         result, why = read_result(o.result_file)
         o.result = result if isinstance(result, dict) else None
         if why is not None:

@@ -30,6 +30,11 @@ def note(what):
         fh.write('%s %s %.6f %s\n' % (what, name, time.time(), port))
 note('start')
 print('run %s: progress: half way' % name, flush=True)
+if mode == 'killed_once':  # killed mid-case (SIGKILL, no clean-up) the first time, fine after
+    flag = journal + '.' + name + '.killed'
+    if not os.path.exists(flag):
+        open(flag, 'w').close()
+        os.kill(os.getpid(), 9)
 if mode == 'hang':
     import subprocess
     child = subprocess.Popen(['sleep', '60'])
@@ -161,6 +166,24 @@ class Pool(Base):
         self.assertEqual(text.count(' done '), 5)
         self.assertIn('FAILED: the soil gave way', text)
         self.assertIn('[5/5]', text)
+
+    def test_a_killed_worker_is_failed_naming_the_signal_and_resume_reruns_only_it(self):
+        cases = dm_sweep.cases([{'mode': 'ok', 'x': 1}, {'mode': 'killed_once', 'x': 2}, {'mode': 'ok', 'x': 3}])
+        s = self.sweep(cases)
+        s.run()
+        by = {o.case['x']: o for o in s.outcomes}
+        self.assertTrue(by[1].ok and by[3].ok)
+        self.assertFalse(by[2].ok)
+        self.assertEqual(by[2].returncode, -9)
+        self.assertRegex(by[2].error, r'^killed by SIGKILL mid-case; see .*modekilled-once_x2\.log$')
+        self.assertEqual(s.exit_status(), 1)
+        # --resume keeps the finished cases and runs the killed one again
+        again = self.sweep(cases)
+        kept = again.resume()
+        self.assertEqual(sorted(o.name for o in kept), ['modeok_x1', 'modeok_x3'])
+        again.run()
+        self.assertTrue(all(o.ok for o in again.outcomes))
+        self.assertEqual(self.starts(), ['modeok_x1', 'modekilled-once_x2', 'modeok_x3', 'modekilled-once_x2'])
 
     def test_summary_file(self):
         cases = dm_sweep.grid([('mode', ['ok', 'fail']), ('x', [1])])
