@@ -9,7 +9,7 @@ DM_WS="${DM_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/dem_mobility/ws-$(printf %s "$DM
 export PATH="/usr/bin:$PATH"
 
 DM_CORE_PACKAGES=(cmake g++ make libeigen3-dev libyaml-cpp-dev libgtest-dev libbenchmark-dev)
-DM_ROS_PACKAGES=(catkin ros-core-dev libroscpp-dev libnodeletlib-dev librosbag-dev libtf2-ros-dev
+DM_ROS_PACKAGES=(catkin ros-core-dev rosbash libroscpp-dev libnodeletlib-dev librosbag-dev libtf2-ros-dev
   libtf2-eigen-dev libnodeletlib-tools ros-geometry-msgs ros-sensor-msgs ros-visualization-msgs ros-message-generation
   ros-nav-msgs python3-nav-msgs python3-tf2-msgs ros-rosgraph-msgs ros-tf2-msgs libtopic-tools-dev pluginlib-dev
   python3-rosbag python3-roslaunch python3-rostest python3-catkin-pkg python3-std-msgs python3-geometry-msgs python3-nodelet python3-matplotlib python3-numpy python3-yaml python3-tqdm)
@@ -19,6 +19,8 @@ DM_MAP_PACKAGES=(gdal-bin python3-gdal)
 DM_SLURM_PACKAGES=(slurmctld slurmd slurm-client munge)
 # only for the checks of the test command (package lint, rviz screenshot under Xvfb)
 DM_CHECK_PACKAGES=(catkin-lint rviz xvfb imagemagick)
+# the sanitizer build and the fuzz harnesses (scripts/sanitize.sh): clang, its OpenMP and libFuzzer
+DM_SANITIZE_PACKAGES=(clang libomp-dev libclang-rt-dev)
 # only for the dem_step benchmark (the side-by-side LAMMPS run)
 DM_BENCH_PACKAGES=(lammps openmpi-bin)
 

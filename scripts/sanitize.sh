@@ -1,39 +1,101 @@
 #!/usr/bin/env bash
-# The core tests built with AddressSanitizer and UndefinedBehaviorSanitizer (issue 16), in a build
-# directory of their own ($DM_BUILD/sanitize; RelWithDebInfo, -fno-sanitize-recover: any report
-# fails the test), run with leak detection on. Any report or failing test exits non-zero.
-#   ./scripts/sanitize.sh              the fast tests (about 16 minutes here: the build 5.5, the runs 10)
-#   ./scripts/sanitize.sh dem_test     the tests named (targets of test/core)
-# Not yet part of ./scripts/test.sh: the build alone would add some 5 minutes to the suite.
+# The core built with clang, AddressSanitizer and UndefinedBehaviorSanitizer in a build directory of
+# its own ($DM_BUILD/sanitize; -O1, line tables, -fno-sanitize-recover: any report fails), and
+# (issue 16):
+#  - core test programs run under the sanitizers, leak detection on;
+#  - the libFuzzer harnesses of the configuration loaders (test/fuzz: scene, vehicle, terrain,
+#    soil, calibration table): every input of test/fuzz/regressions/<target>/ once, then a fixed
+#    number of new inputs per harness, seeded with the shipped files (deterministic: -seed=1).
+# Any sanitizer report, failing test, crash, leak or escaping exception exits non-zero; a fuzzer's
+# finding is kept as $DM_BUILD/sanitize/fuzz/<target>-crash-* (copy it into
+# test/fuzz/regressions/<target>/ once fixed: config_test reads those in every build).
+#
+#   ./scripts/sanitize.sh                 what ./scripts/test.sh runs: the quick test programs and
+#                                         DM_FUZZ_RUNS (default 2000) inputs per harness
+#   ./scripts/sanitize.sh --all           all the fast test programs (about 10 min of runs)
+#   ./scripts/sanitize.sh TEST...         the test programs named (targets of test/core)
+#   ./scripts/sanitize.sh --fuzz TARGET [SECONDS]   one harness for longer (default 600 s); its
+#                                         corpus grows in $DM_BUILD/sanitize/fuzz/corpus/TARGET
 # The timing tests of config_test (a signal 1-3 s into a run) assume a build at full speed: they
 # are left out here. vehicle_test runs some 30 times slower under the sanitizers (its climbs take
 # minutes each): name it to run it.
 source "$(dirname "$0")/lib.sh"
-ensure_packages "${DM_CORE_PACKAGES[@]}"
-tests=("$@")
-[ ${#tests[@]} -gt 0 ] || tests=(config_test contact_test joints_test integrator_test soil_law_test pair_kernel_test
-  dem_particles_test powertrain_test dem_pour_test cosim_test dem_test wheel_test)
+ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_SANITIZE_PACKAGES[@]}"
 dir="$DM_BUILD/sanitize"
-flags="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
-say "build: core tests with ASan and UBSan in $dir (${tests[*]})"
-cmake -S "$DM_ROOT" -B "$dir" -DDM_BUILD_ROS=OFF -DDM_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
-cmake --build "$dir" -j"$(nproc)" --target "${tests[@]}" dm_run_scene
+quick=(config_test contact_test joints_test integrator_test soil_law_test pair_kernel_test dem_particles_test
+  powertrain_test)
+fuzz_targets=(scene vehicle terrain soil calibration)
+fuzz_only="" fuzz_seconds=600
+case "${1:-}" in
+  --all) tests=("${quick[@]}" dem_pour_test cosim_test dem_test wheel_test) ;;
+  --fuzz)
+    fuzz_only="${2:?usage: sanitize.sh --fuzz TARGET [SECONDS] (targets: ${fuzz_targets[*]})}"
+    fuzz_seconds="${3:-600}"
+    [[ " ${fuzz_targets[*]} " == *" $fuzz_only "* ]] || { echo "sanitize.sh: no fuzz target '$fuzz_only' (${fuzz_targets[*]})"; exit 2; }
+    tests=() ;;
+  --help|-h) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  "") tests=("${quick[@]}") ;;
+  *) tests=("$@") ;;
+esac
+san="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+say "build: clang, ASan + UBSan + libFuzzer in $dir (${tests[*]:-} fuzz_*)"
+cmake -S "$DM_ROOT" -B "$dir" -DCMAKE_CXX_COMPILER=clang++ -DDM_BUILD_ROS=OFF -DDM_BUILD_BENCH=OFF -DDM_BUILD_FUZZ=ON \
+  -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -gline-tables-only $san -fsanitize=fuzzer-no-link" \
+  -DCMAKE_EXE_LINKER_FLAGS_SANITIZE="-fsanitize=address,undefined" >/dev/null
+targets=(fuzz_seeds)
+for t in "${fuzz_targets[@]}"; do targets+=("fuzz_$t"); done
+cmake --build "$dir" -j"$(nproc)" --target "${tests[@]}" "${targets[@]}" dm_run_scene
 export ASAN_OPTIONS=detect_leaks=1:halt_on_error=1:abort_on_error=0
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 failed=()
 for t in "${tests[@]}"; do
   say "sanitize: $t"
   filter=()
-  [ "$t" = config_test ] && filter=(--gtest_filter=-Config.RunnerInterrupted*)
+  [ "$t" = config_test ] && filter=(--gtest_filter=-Config.RunnerInterrupted*:Config.RunnerOnAFullDisk*)
   if ! (cd "$dir/test/core" && "./$t" "${filter[@]}" >"$dir/$t.log" 2>&1); then
     failed+=("$t")
     grep -E "ERROR: AddressSanitizer|runtime error|LeakSanitizer|FAILED" "$dir/$t.log" | head -20 || true
     echo "(log: $dir/$t.log)"
   fi
 done
+
+# the fuzzers: the shipped files as seeds, a corpus of their own per run (the quick run starts afresh
+# each time so that it repeats; --fuzz keeps and grows its corpus)
+fuzz="$dir/fuzz"
+rm -rf "$fuzz/seeds"
+"$dir/test/fuzz/fuzz_seeds" "$fuzz/seeds" >/dev/null
+fuzz_flags=(-max_len=16384 -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=1024 -print_final_stats=1)
+for t in "${fuzz_targets[@]}"; do
+  [ -z "$fuzz_only" ] || [ "$t" = "$fuzz_only" ] || continue
+  bin="$dir/test/fuzz/fuzz_$t"
+  log="$dir/fuzz_$t.log"
+  regressions=("$DM_ROOT/test/fuzz/regressions/$t"/*)
+  if [ -e "${regressions[0]}" ]; then
+    say "fuzz: $t, its ${#regressions[@]} regression input(s)"
+    if ! "$bin" "${fuzz_flags[@]}" "${regressions[@]}" >"$log" 2>&1; then
+      failed+=("fuzz_$t regressions"); tail -30 "$log"; continue
+    fi
+  fi
+  if [ -n "$fuzz_only" ]; then
+    mkdir -p "$fuzz/corpus/$t"
+    say "fuzz: $t for $fuzz_seconds s (corpus $fuzz/corpus/$t)"
+    run=(-max_total_time="$fuzz_seconds" "$fuzz/corpus/$t" "$fuzz/seeds/$t")
+  else
+    rm -rf "$fuzz/corpus/quick_$t"; mkdir -p "$fuzz/corpus/quick_$t"
+    say "fuzz: $t, ${DM_FUZZ_RUNS:-2000} inputs"
+    run=(-runs="${DM_FUZZ_RUNS:-2000}" -seed=1 "$fuzz/corpus/quick_$t" "$fuzz/seeds/$t")
+  fi
+  if "$bin" "${fuzz_flags[@]}" -artifact_prefix="$fuzz/$t-" "${run[@]}" >"$log" 2>&1; then
+    grep -E "^stat::number_of_executed_units|^stat::peak_rss_mb|^#[0-9]+ *DONE" "$log" | tr '\n' ' ' || true
+    echo
+  else
+    failed+=("fuzz_$t")
+    grep -E -A12 "ERROR: (AddressSanitizer|libFuzzer|LeakSanitizer)|runtime error|uncaught exception|terminate called" "$log" | head -40 || tail -30 "$log"
+    echo "(log: $log; the input: $(ls "$fuzz/$t"-* 2>/dev/null | head -3 | tr '\n' ' '))"
+  fi
+done
 if [ ${#failed[@]} -gt 0 ]; then
   echo "sanitize: failed: ${failed[*]}"
   exit 1
 fi
-say "sanitize: ${#tests[@]} test programs, no report"
+say "sanitize: ${#tests[@]} test program(s) and the fuzz harness(es): no report"

@@ -7,9 +7,12 @@
 #     calibration sweep on tiny cases (test/ros/test_cone_sweep.py), the single-wheel rig
 #     (test/ros/test_single_wheel.py), the vehicle on the DEM soil patch (test/ros/test_soil_slope.py) and
 #     the speed-made-good map published as an OccupancyGrid (test/ros/test_map_publisher.py),
-#  4. catkin_lint on the package (must report nothing).
+#  4. catkin_lint on the package (must report nothing),
+#  5. the core built with clang under AddressSanitizer and UndefinedBehaviorSanitizer: the quick
+#     core test programs and the libFuzzer harnesses of every configuration loader, their
+#     regression inputs and a fixed number of new inputs each (scripts/sanitize.sh).
 source "$(dirname "$0")/lib.sh"
-ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_MAP_PACKAGES[@]}" "${DM_SLURM_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}"
+ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_MAP_PACKAGES[@]}" "${DM_SLURM_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}" "${DM_SANITIZE_PACKAGES[@]}"
 build_core
 # The core suite is CPU-bound (its tests run side by side on both cores); the stages after it
 # (builds, ROS and python tests) wait on processes, masters and a Slurm scheduler much of the
@@ -46,6 +49,8 @@ say "test: catkin_lint"
 lint=$(cd "$DM_WS/src" && catkin_lint dem_mobility 2>&1 | grep -v rosdep)
 echo "$lint"
 echo "$lint" | grep -q "found 0 problems" || { echo "catkin_lint reported problems"; exit 1; }
+say "test: sanitizers and fuzzers (clang: ASan + UBSan, libFuzzer; beside the core suite)"
+bash "$DM_ROOT/scripts/sanitize.sh"
 say "test: core suite (ctest): waiting for it"
 wait "$ctest_pid" || true
 trap - EXIT

@@ -82,7 +82,7 @@ class TerrainNodelet : public nodelet::Nodelet {
       std::unique_ptr<TerrainModel> model =
           LoadTerrainModel(scene.terrain_file, TerrainVehicleOf(VehicleSpec::Load(scene.vehicle_file)),
                            scene.terrain_overrides, [this] { return stop_prepare_.load() || !ros::ok(); });
-      model->SetGravity(VehicleCoSim::GradeGravity(scene.grade_deg));  // the soil on the grade, as in-process
+      model->SetGravity(scene.Gravity());  // the soil on the grade, as in-process
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       server = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(
           nh, transport, exchange_name_, "exchange/wheel_states", "exchange/wheel_wrenches", timing);

@@ -322,7 +322,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
 
   void PublishStatic() {
     tf2_msgs::TFMessage m;
-    m.transforms.push_back(GradeTransform(scene_.grade_deg, ros::Time(0), map_frame_, world_frame_));
+    m.transforms.push_back(SlopeTransform(scene_.Gravity(), ros::Time(0), map_frame_, world_frame_));
     tf_static_.Publish(m);
   }
 

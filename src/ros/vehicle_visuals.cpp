@@ -63,14 +63,15 @@ bool StartsWith(const std::string& s, const std::string& p) { return s.rfind(p, 
 
 }  // namespace
 
-geometry_msgs::TransformStamped GradeTransform(double grade_deg, const ros::Time& stamp, const std::string& map,
-                                               const std::string& world) {
+geometry_msgs::TransformStamped SlopeTransform(const Eigen::Vector3d& gravity, const ros::Time& stamp,
+                                               const std::string& map, const std::string& world) {
   geometry_msgs::TransformStamped t;
   t.header.stamp = stamp;
   t.header.frame_id = map;
   t.child_frame_id = world;
-  // world x (uphill) rises in map: a rotation of -grade about y
-  const Eigen::Quaterniond q(Eigen::AngleAxisd(-grade_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()));
+  // the slope frame's "up" (against gravity) onto map's z by the least rotation: for a grade alone
+  // a rotation of -grade about y (world x, uphill, rises in map), a side slope adds the roll
+  const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(-gravity.normalized(), Eigen::Vector3d::UnitZ());
   t.transform = T(Eigen::Vector3d::Zero(), q);
   return t;
 }

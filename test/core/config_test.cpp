@@ -17,6 +17,7 @@
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
+#include "fuzz_targets.h"
 
 namespace dem_mobility::core {
 namespace {
@@ -168,6 +169,87 @@ TEST(Config, RunnerExitsNonZeroWithTheMessage) {
       << ss.str();
 }
 
+// What a command prints (stdout and stderr) and its exit status.
+struct Command {
+  int rc = -1;
+  std::string out;
+  explicit Command(const std::string& cmd) {
+    const std::string file = (fs::temp_directory_path() / ("dm_cmd_" + std::to_string(::getpid()) + ".txt")).string();
+    rc = std::system((cmd + " > " + file + " 2>&1").c_str());
+    std::ifstream in(file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    out = ss.str();
+    fs::remove(file);
+  }
+  int status() const { return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1; }
+};
+
+TEST(Config, RunnerHelpAndCheckRunNothing) {
+  const Command help(std::string(DM_RUN_SCENE) + " --help");
+  EXPECT_EQ(help.status(), 0);
+  for (const char* s : {"--check", "soil_slope", "single_wheel", "exit status"}) EXPECT_NE(help.out.find(s), std::string::npos) << s;
+  // --check reads the scene and every file it names, and prepares no soil: the soil scene at coarse
+  // (a preparation of minutes) comes back at once with its verdict
+  const Command good(std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR "/scenes/soil_slope.yaml --check");
+  EXPECT_EQ(good.status(), 0) << good.out;
+  EXPECT_NE(good.out.find("soil_slope.yaml: ok (soil_slope"), std::string::npos) << good.out;
+  EXPECT_EQ(good.out.find("prepar"), std::string::npos) << good.out;
+  // what a run refuses before it starts, the check refuses: a soil narrower than the track (in the
+  // terrain file the scene names), a cone index outside the calibration table, a bad soil file
+  const std::string soil = std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR "/scenes/soil_slope.yaml --check ";
+  const Command narrow(soil + "terrain_overrides.levels.coarse.width=1.5");
+  EXPECT_EQ(narrow.status(), 1);
+  EXPECT_NE(narrow.out.find("soil_patch.yaml: levels.coarse.width: the soil (1.5 m wide) is narrower than the vehicle's track"),
+            std::string::npos) << narrow.out;
+  const Command ci(soil + "terrain_overrides.cone_index=900");
+  EXPECT_EQ(ci.status(), 1);
+  EXPECT_NE(ci.out.find("soil_patch.yaml: cone_index"), std::string::npos) << ci.out;
+  const Command road(std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR "/scenes/road_slope.yaml --check terrain=/dev/zero");
+  EXPECT_EQ(road.status(), 1);
+  EXPECT_NE(road.out.find("/dev/zero: not a regular file"), std::string::npos) << road.out;
+  for (const char* scene : {"road_slope", "single_wheel", "cone_penetrometer", "dem_pour", "uniaxial_compression"}) {
+    const Command c(std::string(DM_RUN_SCENE) + " " DM_CONFIG_DIR "/scenes/" + scene + ".yaml --check");
+    EXPECT_EQ(c.status(), 0) << scene << ": " << c.out;
+  }
+}
+
+TEST(Config, EveryShippedFileReadsThroughItsFuzzTarget) {
+  // the fuzzers' seeds are the shipped files: each reads and checks without any error, so that a
+  // target that refused everything (a wrong folder, a wrong file name) cannot pass for a fuzzer
+  for (const fuzz::Target& t : fuzz::Targets()) {
+    const std::vector<std::string> seeds = t.seeds();
+    EXPECT_FALSE(seeds.empty()) << t.name;
+    for (size_t i = 0; i < seeds.size(); ++i) EXPECT_NO_THROW(t.read(seeds[i])) << t.name << " seed " << i;
+  }
+  // and a malformed one is refused with the file named
+  try {
+    fuzz::FindTarget("soil").read("density: [1");
+    ADD_FAILURE() << "malformed soil read";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("soils/fuzz_input.yaml"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Config, TheFuzzersFindingsStayFixed) {
+  // every input the fuzz harnesses found a defect with (test/fuzz/regressions/<target>/, see
+  // scripts/sanitize.sh) reads as bad input now: a ConfigError, nothing else
+  int inputs = 0;
+  for (const fuzz::Target& t : fuzz::Targets()) {
+    const fs::path dir = fs::path(DM_FUZZ_REGRESSIONS) / t.name;
+    if (!fs::exists(dir)) continue;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      std::ifstream in(e.path(), std::ios::binary);
+      std::stringstream ss;
+      ss << in.rdbuf();
+      const std::string data = ss.str();
+      EXPECT_NO_THROW(t.Run(reinterpret_cast<const std::uint8_t*>(data.data()), data.size())) << e.path();
+      ++inputs;
+    }
+  }
+  EXPECT_GT(inputs, 0) << DM_FUZZ_REGRESSIONS;
+}
+
 TEST(Config, SceneTerrainOverridesTakeNestedKeysAsDottedOnes) {
   // terrain_overrides.levels.tiny.length=6 on the command line makes a nested map in the scene;
   // it overrides the terrain file's levels.tiny.length as a dotted key written in the scene does
@@ -224,6 +306,7 @@ TEST(Config, RunnerInterruptedKeepsTheRunsResult) {
   const RunnerRun run("dm_runner_interrupt", "timeout --preserve-status -s TERM 3", "road_slope.yaml", "duration=40");
   ASSERT_TRUE(WIFEXITED(run.rc));
   EXPECT_EQ(WEXITSTATUS(run.rc), 4);
+  EXPECT_LT(run.wall, 4.0);  // the signal at 3 s, then within a second
   const YAML::Node r = YAML::LoadFile(run.result);
   EXPECT_EQ(r["status"].as<std::string>(), "interrupted");
   EXPECT_TRUE(r["interrupted"].as<bool>());

@@ -107,6 +107,43 @@ TEST(Integrator, StableBelowAndUnstableAboveTwoOverOmega) {
   EXPECT_GT(OscillatorAmplitude(1.02), 1e6);
 }
 
+// A light mass held by two springs to the ground: each spring's own mode is omega^2 = k/m, the
+// pair's 2k/m. The guard sums the modes on the body (a bound on the assembled system's highest
+// frequency): its critical step is the pair's, 2/sqrt(2k/m), exact here; the stiffest element alone
+// would allow sqrt(2) times that, where the run diverges.
+double TwoSpringAmplitude(double step) {
+  MultibodySystem s;
+  s.set_gravity(Vector3d::Zero());
+  const int b = s.AddBody(test::MakeBody("mass", 2.0, Vector3d(1.0, 1.0, 1.0)));
+  s.point_joints.push_back(test::MakePoint(s, 0, b, Vector3d::Zero(), 800.0, 0.0));
+  s.point_joints.push_back(test::MakePoint(s, 0, b, Vector3d::Zero(), 800.0, 0.0));
+  s.mutable_body(b).v = Vector3d(1.0, 0.0, 0.0);
+  s.Finalize(step, /*check_step=*/false);
+  double amax = 0.0;
+  try {
+    for (int n = 0; n < 5000; ++n) {
+      s.Step();
+      amax = std::max(amax, s.body(b).x.norm());
+    }
+  } catch (const SimulationError&) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return amax * std::sqrt(1600.0 / 2.0);
+}
+
+TEST(Integrator, GuardSumsTheElementsOnABody) {
+  MultibodySystem s;
+  const int b = s.AddBody(test::MakeBody("mass", 2.0, Vector3d(1.0, 1.0, 1.0)));
+  s.point_joints.push_back(test::MakePoint(s, 0, b, Vector3d::Zero(), 800.0, 0.0));
+  s.point_joints.push_back(test::MakePoint(s, 0, b, Vector3d::Zero(), 800.0, 0.0));
+  const double pair = 2.0 / std::sqrt(2.0 * 800.0 / 2.0), single = 2.0 / std::sqrt(800.0 / 2.0);
+  EXPECT_NEAR(s.CriticalTimeStep().dt_crit, pair, 1e-12);
+  EXPECT_EQ(s.CriticalTimeStep().element, "body 'mass'");
+  EXPECT_LT(TwoSpringAmplitude(0.98 * pair), 6.0);
+  EXPECT_GT(TwoSpringAmplitude(1.02 * pair), 1e6);
+  EXPECT_GT(TwoSpringAmplitude(0.9 * single), 1e6);  // what the stiffest element alone would allow
+}
+
 TEST(Integrator, GuardRefusesAStepAboveTheLimit) {
   Oscillator o(2.0, 800.0);
   try {

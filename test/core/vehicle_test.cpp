@@ -317,6 +317,86 @@ TEST(Vehicle, CouplingIntervalExchangesEveryNthStepAndHoldsTheWrenches) {
   EXPECT_NEAR(total, v.system().TotalMass() * 9.81, 0.01 * v.system().TotalMass() * 9.81);
 }
 
+// The vehicle's energy ledger (Vehicle::Energy, followed by the run): the engine's work is the
+// integral of its torque times the drive shaft's speed (checked against the history's own 100 Hz
+// samples), the road's rolling resistance takes c_rr m g per metre of it, and what is left went to
+// the dampers, brakes and differentials: never negative.
+TEST(VehicleEnergy, TheEngineGivesTheRoadsRollingResistanceTakesTheDampersNeverGive) {
+  MobilityRunParams p = Scene(0.0);
+  p.duration = 8.0;
+  MobilityRun s(p);
+  const MobilityRunResult r = s.Run();
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  const EnergyReport& e = r.vehicle_energy;
+  double engine = 0.0;
+  for (size_t i = 1; i < r.history.size(); ++i) {
+    const MobilitySample &a = r.history[i - 1], &b = r.history[i];
+    engine += 0.5 * (b.t - a.t) * (a.drive_torque * a.drive_shaft_speed + b.drive_torque * b.drive_shaft_speed);
+  }
+  EXPECT_GT(engine, 1e5);
+  EXPECT_NEAR(e.exchanged, engine, 0.01 * engine);
+  const YamlReader road = YamlReader::Load(DM_CONFIG_DIR "/terrains/rigid_road.yaml");
+  const double c_rr = road.Child("contact").Double("c_rr");
+  const double weight = s.vehicle().system().TotalMass() * 9.81, distance = r.history.back().x;
+  EXPECT_GT(distance, 20.0);
+  // The same run without rolling resistance: the road's work differs by the resistance's, c_rr m g
+  // per metre (the rest of what the road takes, the same in both, is the rigid polygonal tire's
+  // vertices striking the road, damped, and the tires' slip)
+  MobilityRunParams q = p;
+  q.terrain_overrides.push_back("contact.c_rr=0");
+  MobilityRun free(q);
+  const MobilityRunResult f = free.Run();
+  ASSERT_TRUE(f.error.empty()) << f.error;
+  const double rolling = c_rr * weight * distance, difference = f.vehicle_energy.wall_work - e.wall_work;
+  std::printf("the road's work %.0f J, %.0f J without rolling resistance: %.0f J apart, c_rr m g d = %.0f J\n",
+              -e.wall_work, -f.vehicle_energy.wall_work, difference, rolling);
+  EXPECT_NEAR(difference, rolling, 0.03 * rolling);
+  EXPECT_GT(e.dissipated, 0.0);
+  EXPECT_GE(r.vehicle_ledger.least, -1e-3 * r.vehicle_ledger.Scale());
+  EXPECT_DOUBLE_EQ(r.vehicle_ledger.dissipated, e.dissipated);  // the watch starts at the run's first step
+  EXPECT_GT(r.vehicle_ledger.samples, 800);
+}
+
+// A vehicle set rolling (start_speed): every wheel turns at v / r and every shaft and gear as its
+// couplings and CV joints require, so nothing is strained at the start; dropped from 0.5 m onto
+// the road, it lands and settles with its ledger never below zero.
+TEST(VehicleEnergy, ARollingStartStrainsNothingAndADropDissipates) {
+  MobilityRunParams p = Scene(0.0);
+  p.start_speed = 10.0;
+  p.settle_time = 0.0;
+  p.driver.full_throttle = true;
+  p.duration = 0.5;
+  MobilityRun s(p);
+  const Vehicle& v = s.vehicle();
+  const double w = 10.0 / v.tire().radius;
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(v.WheelSpeed(i), w, 1e-9 * w) << i;
+  EXPECT_NEAR(v.DriveShaftSpeed(), w / v.driveline_reduction(), 1e-9 * w / v.driveline_reduction());
+  for (const RotationalCoupling& c : v.system().couplings) EXPECT_NEAR(c.Rate(v.system().bodies()), 0.0, 1e-9 * w) << c.name;
+  EXPECT_NEAR(v.ForwardSpeed(), 10.0, 1e-12);
+  const MobilityRunResult r = s.Run();
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_NEAR(r.history.front().speed, 10.0, 0.05);  // no start-up jolt
+  EXPECT_GE(r.vehicle_ledger.least, -1e-3 * r.vehicle_ledger.Scale());
+
+  MobilityRunParams d = Scene(0.0);
+  d.start_height = 0.5;
+  d.settle_time = 1.5;
+  d.duration = 0.1;
+  MobilityRun drop(d);
+  const double z0 = drop.vehicle().ChassisFramePosition().z();
+  const MobilityRunResult q = drop.Run();
+  ASSERT_TRUE(q.error.empty()) << q.error;
+  const double fall = z0 - drop.vehicle().ChassisFramePosition().z();
+  EXPECT_NEAR(fall, 0.5, 0.05);  // landed and settled where it would have stood
+  EXPECT_LT(q.vehicle_energy.wall_work, 0.0);  // the road took energy (its dampers and friction)
+  EXPECT_GT(q.vehicle_ledger.dissipated, 0.0);
+  EXPECT_GE(q.vehicle_ledger.least, -1e-3 * q.vehicle_ledger.Scale());
+  // what the drop lost: the weight times the fall, less the little left in motion and springs
+  const double lost = -q.vehicle_energy.wall_work + q.vehicle_ledger.dissipated;
+  const double mgh = drop.vehicle().system().TotalMass() * 9.81 * fall;
+  EXPECT_NEAR(lost, mgh, 0.05 * mgh);
+}
+
 TEST(Vehicle, TimeStepAboveTheCriticalOneIsRefused) {
   MobilityRunParams p = Scene(0.0);
   MobilityRun probe(p);

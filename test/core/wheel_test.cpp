@@ -27,6 +27,12 @@ TireGeometry PaperTire() { return TireGeometry::Read(YamlReader::Load(DM_CONFIG_
 TEST(TireSurface, IsClosedButForTheHubAndHasThePapersTriangles) {
   const TireGeometry t = PaperTire();
   EXPECT_GT(t.mesh.faces.size(), 6600u);  // the paper: more than 6,600 triangles on the tread
+  // ours (tire.yaml, docs/single-wheel.md): 144 x 24 tread vertices, 144 x 23 x 2 triangles; the
+  // soil surface adds 4 rings of 144 on each sidewall and their 2 x 4 x 144 x 2 triangles
+  EXPECT_EQ(t.mesh.vertices.size(), 144u * 24u);
+  EXPECT_EQ(t.mesh.faces.size(), 144u * 23u * 2u);
+  EXPECT_EQ(t.soil_mesh.vertices.size(), 144u * 24u + 2u * 4u * 144u);
+  EXPECT_EQ(t.soil_mesh.faces.size(), 144u * 23u * 2u + 2u * 4u * 144u * 2u);
   // every edge is shared by two triangles, except the two rim circles (the hub's hole)
   std::map<std::pair<int, int>, int> edges;
   for (const auto& f : t.soil_mesh.faces)

@@ -14,9 +14,10 @@
 
 namespace dem_mobility {
 
-/// map -> world (the slope frame): the grade as a pitch, so that gravity points down in map.
-geometry_msgs::TransformStamped GradeTransform(double grade_deg, const ros::Time& stamp, const std::string& map,
-                                               const std::string& world);
+/// map -> world (the slope frame of `gravity`): the grade as a pitch and a side slope as a roll, so
+/// that gravity points down in map.
+geometry_msgs::TransformStamped SlopeTransform(const Eigen::Vector3d& gravity, const ros::Time& stamp,
+                                               const std::string& map, const std::string& world);
 /// world -> base (the chassis reference frame), and base -> each other body (its COM frame, named
 /// after the body).
 tf2_msgs::TFMessage BodyTransforms(const Vehicle& v, const ros::Time& stamp, const std::string& world,

@@ -1,6 +1,7 @@
 #include "dem_mobility/core/common/yaml_reader.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -27,6 +28,16 @@ YamlReader::YamlReader(YAML::Node node, std::string file, std::string path)
       used_(std::make_shared<std::set<std::string>>()) {}
 
 YamlReader YamlReader::Load(const std::string& path) {
+  // a configuration file is a regular file of modest size (a folder or a device such as /dev/zero,
+  // named by mistake, would read as nothing or without end)
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw ConfigError(path + ": cannot open file (missing or unreadable)");
+  if (!std::filesystem::is_regular_file(status)) throw ConfigError(path + ": not a regular file (a folder or a device?)");
+  const auto bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > kMaxFileBytes)
+    throw ConfigError(path + ": " + std::to_string(bytes) + " bytes, more than a configuration file may have (" +
+                      std::to_string(kMaxFileBytes) + ")");
   std::ifstream in(path);
   if (!in) throw ConfigError(path + ": cannot open file (missing or unreadable)");
   std::stringstream ss;
@@ -205,9 +216,15 @@ Table1D YamlReader::Table(const std::string& key) const {
   }
 }
 
+std::string YamlReader::KeyText(const YAML::Node& key) const {
+  // a key is a word; YAML also allows a list or a map as a key (`? [a, b]: 1`), which no file of ours has
+  if (!key.IsScalar()) Fail("", "a key must be a plain word, found " + Show(key));
+  return key.Scalar();
+}
+
 std::vector<std::string> YamlReader::Keys() const {
   std::vector<std::string> keys;
-  for (const auto& kv : node_) keys.push_back(kv.first.as<std::string>());
+  for (const auto& kv : node_) keys.push_back(KeyText(kv.first));
   return keys;
 }
 
@@ -240,7 +257,7 @@ void YamlReader::Finish() const {
   if (!node_.IsMap()) return;
   std::string unknown;
   for (const auto& kv : node_) {
-    const std::string k = kv.first.as<std::string>();
+    const std::string k = KeyText(kv.first);
     if (!used_->count(k)) unknown += (unknown.empty() ? "" : ", ") + k;
   }
   if (!unknown.empty()) Fail("", "unknown key(s): " + unknown);

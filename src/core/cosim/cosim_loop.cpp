@@ -94,6 +94,18 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
         }
         if (k >= run_steps) break;
       }
+      if (sim.step() % sample_every == 0) {
+        LedgerWatch& w = r.vehicle_ledger;
+        w.Sample(veh.Energy(), sim.driver_time());
+        // the energy watchdog: a vehicle whose energy rises past what the terrain and the engine
+        // put in is unstable (its dampers cannot give energy): stop, naming the step and the guard
+        if (w.least < -kLedgerTolerance * w.Scale() - 1e-6 || !w.finite())
+          throw SimulationError(detail::Concat(
+              "step ", sim.step(), " (t = ", sim.driver_time(), " s): the vehicle's energy rose ", -w.least,
+              " J above what the terrain and the engine put in (more than ", kLedgerTolerance, " of the ", w.Scale(),
+              " J through its ledger): the explicit integration is unstable at dt = ", dt, " s (the guard's critical step ",
+              sim.limit().dt_crit, " s, ", sim.limit().element, ")"));
+      }
       if (observer && observer->StopRequested()) {
         r.interrupted = true;
         break;
@@ -104,12 +116,23 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
   } catch (const SimulationError& e) {
     r.error = e.what();
   }
+  r.vehicle_energy = veh.Energy();
+  r.vehicle_ledger.Sample(r.vehicle_energy, sim.driver_time());
+  const LedgerWatch& w = r.vehicle_ledger;
+  if (!r.error.empty() && r.error.find("vehicle's energy rose") == std::string::npos &&
+      (w.least < -kLedgerTolerance * w.Scale() - 1e-6 || !w.finite()))
+    // a blow-up that something else caught first (a wheel thrown off the road): say what it was
+    r.error = detail::Concat("the vehicle's energy rose ", -w.least, " J above what the terrain and the engine put in (",
+                             "more than ", kLedgerTolerance, " of the ", w.Scale(), " J through its ledger): the explicit ",
+                             "integration is unstable at dt = ", dt, " s (the guard's critical step ", sim.limit().dt_crit,
+                             " s, ", sim.limit().element, "); it stopped at: ", r.error);
   r.steps = sim.step();
   r.exchanges = sim.exchanges();
   r.sim_time = r.history.empty() ? 0.0 : r.history.back().t;
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   r.smg = DetectSpeedMadeGood(r.history, p.plateau, p.driver.v_max);
-  r.steady = SteadyWindowFigures(r.history, p.plateau.window, veh.system().TotalMass(), p.grade_deg);
+  r.steady = SteadyWindowFigures(r.history, p.plateau.window, veh.system().TotalMass(), p.grade_deg,
+                                 p.side_slope_deg);
   return r;
 }
 

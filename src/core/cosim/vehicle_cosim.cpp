@@ -6,18 +6,15 @@
 
 namespace dem_mobility::core {
 
-Eigen::Vector3d VehicleCoSim::GradeGravity(double deg) {
-  const double a = deg * M_PI / 180.0;
-  return 9.81 * Eigen::Vector3d(-std::sin(a), 0.0, -std::cos(a));
-}
-
 VehicleCoSim::VehicleCoSim(const MobilityRunParams& p, const VehicleSpec& spec) : p_(p) {
   // the chassis frame at x = 0 with the tires just touching the plane z = 0
   vehicle_ = Vehicle::Build(spec, Eigen::Vector3d::Zero());
   MultibodySystem& sys = vehicle_->system();
-  const Eigen::Vector3d shift(0.0, 0.0, vehicle_->design_ride_height());
+  // (start_height above that: a drop)
+  const Eigen::Vector3d shift(0.0, 0.0, vehicle_->design_ride_height() + p.start_height);
   for (int i = 1; i < sys.num_bodies(); ++i) sys.mutable_body(i).x += shift;
-  sys.set_gravity(GradeGravity(p.grade_deg));
+  sys.set_gravity(p.Gravity());
+  if (p.start_speed != 0.0) vehicle_->SetRollingSpeed(p.start_speed);
   states_.resize(kWheels);
   wrenches_.resize(kWheels);
 }
@@ -43,8 +40,8 @@ void VehicleCoSim::Exchange(TerrainPort& terrain) {
 void VehicleCoSim::CheckContactLimit() {
   // the contact the terrain reports must stay within the explicit limit of the step in use
   const WheelWrench& w0 = wrenches_[0];
-  if (dt_ > 0.0 && (w0.stiffness != checked_stiffness_ || w0.damping != checked_damping_)) {
-    const TimeStepLimit c = vehicle_->WheelContactLimit(w0.stiffness, w0.damping);
+  if (p_.time_step_guard && dt_ > 0.0 && (w0.stiffness != checked_stiffness_ || w0.damping != checked_damping_)) {
+    const TimeStepLimit c = vehicle_->CriticalTimeStep(w0.stiffness, w0.damping);
     if (dt_ > c.dt_crit)
       throw SimulationError(detail::Concat("step ", step(), " (t = ", time(), " s): time step ", dt_,
                                            " s is above the critical step ", c.dt_crit, " s of ", c.element, " (",
@@ -58,9 +55,8 @@ void VehicleCoSim::Start(TerrainPort& terrain) {
   DM_DEMAND(dt_ == 0.0);
   Exchange(terrain);
   MultibodySystem& sys = vehicle_->system();
-  limit_ = sys.CriticalTimeStep();
-  const TimeStepLimit contact = vehicle_->WheelContactLimit(wrenches_[0].stiffness, wrenches_[0].damping);
-  if (contact.dt_crit < limit_.dt_crit) limit_ = contact;
+  // the vehicle's elements and the terrain's contact on its wheels together
+  limit_ = vehicle_->CriticalTimeStep(wrenches_[0].stiffness, wrenches_[0].damping);
   double dt = p_.time_step > 0.0 ? p_.time_step : p_.time_step_safety * limit_.dt_crit;
   int coupling = p_.coupling_interval;
   const double h = terrain.description().time_step;
@@ -79,12 +75,12 @@ void VehicleCoSim::Start(TerrainPort& terrain) {
                                          "'); use time_step: auto"));
     }
   }
-  if (!(dt <= limit_.dt_crit))
+  if (p_.time_step_guard && !(dt <= limit_.dt_crit))
     throw ConfigError(detail::Concat(p_.file, ": time_step: time step dt = ", dt, " s is above the critical step ",
                                      limit_.dt_crit, " s of ", limit_.element, " (", limit_.detail, "); use dt <= ",
                                      limit_.dt_crit, " s or soften that element"));
   try {
-    sys.Finalize(dt);
+    sys.Finalize(dt, p_.time_step_guard);
   } catch (const ConfigError& e) {
     throw ConfigError(p_.file + ": time_step: " + e.what());
   }

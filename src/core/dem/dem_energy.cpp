@@ -5,6 +5,18 @@
 
 namespace dem_mobility::core {
 
+double NormalEnergy(const SoilContactLaw& law, double d, double fmax) {
+  if (!(d > 0.0)) return 0.0;
+  const double d0 = law.d0, dp = law.dp;
+  double u = 0.0;
+  if (d > d0) u += 0.5 * law.k_n * (d - d0) * (d - d0);
+  if (law.cohesion && fmax > 0.0 && dp > 0.0) {
+    const double a = std::min(d, d0);
+    u -= a <= dp ? 0.5 * fmax * a * a / dp : 0.5 * fmax * dp + fmax * (a - dp) - 0.5 * fmax * (a - dp) * (a - dp) / (d0 - dp);
+  }
+  return u;
+}
+
 double PairEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists, int i, int k) {
   // the elastic energy stored in one contact: its normal branches (repulsion, and the adhesion
   // triangle's potential, zero out of contact) and its anchor spring
@@ -12,15 +24,8 @@ double PairEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const Neighb
   const int j = lists.partners()[k];
   const double d = (e.diameter - (ps.x[i] - ps.x[j]).norm()) - (ps.plastic[i] + ps.plastic[j]);
   const double fmax = std::min(ps.adhesion_max[i], ps.adhesion_max[j]);
-  double u = lists.touching()[k] ? 0.5 * law.friction.k_t * lists.histories()[k].spring.squaredNorm() : 0.0;
-  if (!(d > 0.0)) return u;
-  const double d0 = law.d0, dp = law.dp;
-  if (d > d0) u += 0.5 * law.k_n * (d - d0) * (d - d0);
-  if (law.cohesion && fmax > 0.0 && dp > 0.0) {
-    const double a = std::min(d, d0);
-    u -= a <= dp ? 0.5 * fmax * a * a / dp : 0.5 * fmax * dp + fmax * (a - dp) - 0.5 * fmax * (a - dp) * (a - dp) / (d0 - dp);
-  }
-  return u;
+  const double u = lists.touching()[k] ? 0.5 * law.friction.k_t * lists.histories()[k].spring.squaredNorm() : 0.0;
+  return u + NormalEnergy(law, d, fmax);
 }
 
 EnergyReport MechanicalEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists) {

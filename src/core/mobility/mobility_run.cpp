@@ -31,6 +31,8 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
           flatten(o.Child(k), prefix + k + ".");
         else if (o.IsList(k))  // (terrain_overrides.patch.check_window=[0.3,0.7])
           p.terrain_overrides.push_back(prefix + k + "=" + o.FlowText(k));
+        else if (!o.Has(k))  // null (terrain_overrides.cone_index=~: the file's cone index unset, f given instead)
+          p.terrain_overrides.push_back(prefix + k + "=~");
         else
           p.terrain_overrides.push_back(prefix + k + "=" + o.String(k));
       }
@@ -39,10 +41,14 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
     flatten(y.Child("terrain_overrides"), "");
   }
   p.grade_deg = y.DoubleIn("grade_deg", -45.0, 45.0);
+  p.side_slope_deg = y.DoubleIn("side_slope_deg", -45.0, 45.0, 0.0);
+  p.start_height = y.DoubleIn("start_height", 0.0, 5.0, 0.0);
+  p.start_speed = y.DoubleIn("start_speed", 0.0, 40.0, 0.0);
   p.duration = y.DoubleIn("duration", 1e-3, 3600.0);
   p.settle_time = y.DoubleIn("settle_time", 0.0, 10.0, 0.5);
   if (y.Has("time_step") && y.String("time_step") != "auto") p.time_step = y.DoubleIn("time_step", 1e-7, 1e-2);
-  p.time_step_safety = y.DoubleIn("time_step_safety", 0.01, 1.0, 0.5);
+  p.time_step_safety = y.DoubleIn("time_step_safety", 0.01, 1.0, 0.9);
+  p.time_step_guard = y.Bool("time_step_guard", true);
   p.coupling_interval = y.Int("coupling_interval", 1);
   if (p.coupling_interval < 1 || p.coupling_interval > 1000)
     y.Fail("coupling_interval", "must be a whole number of steps in [1, 1000], found " + std::to_string(p.coupling_interval));
@@ -59,6 +65,11 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
   res.Finish();
   y.Finish();
   return p;
+}
+
+Eigen::Vector3d MobilityRunParams::Gravity() const {
+  const double a = grade_deg * M_PI / 180.0, b = side_slope_deg * M_PI / 180.0;
+  return 9.81 * Eigen::Vector3d(-std::sin(a), -std::cos(a) * std::sin(b), -std::cos(a) * std::cos(b));
 }
 
 double StalledFor(const std::vector<MobilitySample>& h, double stall_speed) {
@@ -131,10 +142,11 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
   return s;
 }
 
-SteadyFigures SteadyWindowFigures(const std::vector<MobilitySample>& h, double window, double mass, double grade_deg) {
+SteadyFigures SteadyWindowFigures(const std::vector<MobilitySample>& h, double window, double mass, double grade_deg,
+                                  double side_slope_deg) {
   SteadyFigures f;
   if (h.empty()) return f;
-  const double a = grade_deg * M_PI / 180.0, wn = mass * 9.81 * std::cos(a);
+  const double a = grade_deg * M_PI / 180.0, wn = mass * 9.81 * std::cos(a) * std::cos(side_slope_deg * M_PI / 180.0);
   const double t_end = h.back().t;
   double pull = 0.0, thrust = 0.0;
   for (auto it = h.rbegin(); it != h.rend() && it->t >= t_end - window; ++it) {
@@ -167,6 +179,10 @@ ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParam
   ResultFile f(p.file, p.kind);
   f.SetStatus(r.Status(), r.error);
   f.Set("grade_deg", p.grade_deg);
+  if (p.side_slope_deg != 0.0) f.Set("side_slope_deg", p.side_slope_deg);
+  if (p.start_height != 0.0) f.Set("start_height", p.start_height);
+  if (p.start_speed != 0.0) f.Set("start_speed", p.start_speed);
+  if (!p.time_step_guard) f.Set("time_step_guard", false);
   f.Set("terrain", p.terrain_file);
   f.Set("terrain_model", r.terrain_model);
   f.Set("cone_index_psi", r.cone_index);
@@ -196,6 +212,19 @@ ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParam
   f.Set("wall_time", r.wall_time);
   f.Set("real_time_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0);
   f.Set("interrupted", r.interrupted);
+  // the vehicle's energy ledger (Vehicle::Energy): what the terrain and the engine put in, what the
+  // dampers, brakes and differentials took; followed along the run (docs/stability.md)
+  const EnergyReport& e = r.vehicle_energy;
+  const LedgerWatch& w = r.vehicle_ledger;
+  f.Set("vehicle_energy_kinetic", e.kinetic);
+  f.Set("vehicle_energy_terrain_work", e.wall_work);
+  f.Set("vehicle_energy_engine_work", e.exchanged);
+  f.Set("vehicle_energy_dissipated", w.dissipated);
+  f.Set("vehicle_energy_dissipated_least", w.least);
+  f.Set("vehicle_energy_dissipated_least_time", w.least_time);
+  f.Set("vehicle_energy_largest_fall", w.largest_fall);
+  f.Set("vehicle_energy_scale", w.Scale());
+  f.Set("vehicle_energy_samples", w.samples);
   if (!published.empty()) f.SetCounts("published", published);
   if (terrain) terrain->Describe(&f);
   return f;

@@ -10,7 +10,7 @@ MobilityRun::MobilityRun(const MobilityRunParams& p, const std::function<bool()>
       port_(*terrain_),
       driver_(p.driver, spec_),
       sim_(p, spec_) {
-  terrain_->SetGravity(VehicleCoSim::GradeGravity(p.grade_deg));  // the soil on the grade too
+  terrain_->SetGravity(p.Gravity());  // the soil on the grade too
   sim_.Start(port_);
 }
 
@@ -20,7 +20,7 @@ MobilityRun::MobilityRun(const MobilityRunParams& p, std::unique_ptr<TerrainMode
       port_(*terrain_),
       driver_(p.driver, spec_),
       sim_(p, spec_) {
-  terrain_->SetGravity(VehicleCoSim::GradeGravity(p.grade_deg));  // the soil on the grade too
+  terrain_->SetGravity(p.Gravity());  // the soil on the grade too
   sim_.Start(port_);
 }
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -52,25 +53,51 @@ int MultibodySystem::FindBody(const std::string& name) const {
   return -1;
 }
 
-TimeStepLimit MultibodySystem::CriticalTimeStep() const {
-  TimeStepLimit lim;
-  lim.dt_crit = std::numeric_limits<double>::infinity();
-  auto consider = [&lim](const std::string& kind, const std::string& name, const StiffnessInfo& s) {
-    const double dt = CriticalStep(s.omega, s.zeta);
-    if (dt < lim.dt_crit) {
-      lim.dt_crit = dt;
-      lim.element = kind + " '" + name + "'";
-      lim.detail = s.detail;
+TimeStepLimit MultibodySystem::CriticalTimeStep(const std::vector<BodyMode>& extra) const {
+  const size_t n = bodies_.size();
+  std::vector<double> w2(n, 0.0), zeta(n, 0.0), top(n, 0.0);
+  std::vector<int> count(n, 0);
+  std::vector<std::string> stiffest(n);
+  const auto add = [&](int b, const std::string& name, const StiffnessInfo& s) {
+    if (b < 0 || b >= static_cast<int>(n) || bodies_[b].fixed || !(s.omega > 0.0)) return;
+    const double o2 = s.omega * s.omega;
+    w2[b] += o2;
+    zeta[b] = std::max(zeta[b], s.zeta);
+    ++count[b];
+    if (o2 > top[b]) {
+      top[b] = o2;
+      stiffest[b] = name + " (" + s.detail + ")";
     }
   };
-  for (const auto& e : point_joints) consider("joint", e.name, e.Stiffness(bodies_));
-  for (const auto& e : perpendicular_axes) consider("joint", e.name, e.Stiffness(bodies_));
-  for (const auto& e : orientation_locks) consider("joint", e.name, e.Stiffness(bodies_));
-  for (const auto& e : line_constraints) consider("joint", e.name, e.Stiffness(bodies_));
-  for (const auto& e : couplings) consider("coupling", e.name, e.Stiffness(bodies_));
-  for (const auto& e : cv_twists) consider("joint", e.name, e.Stiffness(bodies_));
-  for (const auto& e : springs) consider("spring", e.name, e.Stiffness(bodies_));
-  for (const auto& e : point_contacts) consider("contact", e.name, e.Stiffness(bodies_));
+  const auto pair = [&](const std::string& kind, const std::string& name, int a, int b, const StiffnessInfo& s) {
+    add(a, kind + " '" + name + "'", s);
+    add(b, kind + " '" + name + "'", s);
+  };
+  for (const auto& e : point_joints) pair("joint", e.name, e.a, e.b, e.Stiffness(bodies_));
+  for (const auto& e : perpendicular_axes) pair("joint", e.name, e.a, e.b, e.Stiffness(bodies_));
+  for (const auto& e : orientation_locks) pair("joint", e.name, e.a, e.b, e.Stiffness(bodies_));
+  for (const auto& e : line_constraints) pair("joint", e.name, e.a, e.b, e.Stiffness(bodies_));
+  for (const auto& e : couplings) {
+    const StiffnessInfo s = e.Stiffness(bodies_);
+    add(e.housing, "coupling '" + e.name + "'", s);
+    for (const auto& t : e.terms) add(t.body, "coupling '" + e.name + "'", s);
+  }
+  for (const auto& e : cv_twists) pair("joint", e.name, e.a, e.b, e.Stiffness(bodies_));
+  for (const auto& e : springs) pair("spring", e.name, e.a, e.b, e.Stiffness(bodies_));
+  for (const auto& e : point_contacts) add(e.body, "contact '" + e.name + "'", e.Stiffness(bodies_));
+  for (const BodyMode& m : extra) add(m.body, m.name, m.mode);
+  TimeStepLimit lim;
+  lim.dt_crit = std::numeric_limits<double>::infinity();
+  for (size_t b = 0; b < n; ++b) {
+    if (count[b] == 0) continue;
+    const double omega = std::sqrt(w2[b]), dt = CriticalStep(omega, zeta[b]);
+    if (dt < lim.dt_crit) {
+      lim.dt_crit = dt;
+      lim.element = "body '" + bodies_[b].name + "'";
+      lim.detail = detail::Concat(count[b], " elements on it together (omega at most ", omega,
+                                  " rad/s, damping ratio ", zeta[b], "), the stiffest ", stiffest[b]);
+    }
+  }
   return lim;
 }
 
@@ -83,10 +110,15 @@ void MultibodySystem::Finalize(double dt, bool check_step) {
   for (const auto& c : point_contacts) DM_THROW_UNLESS(c.terrain != nullptr, "contact '", c.name, "' has no terrain");
   dt_ = dt;
   finalized_ = true;
-  ComputeForces();
+  last_ext_force_.assign(bodies_.size(), Vector3d::Zero());
+  last_ext_torque_.assign(bodies_.size(), Vector3d::Zero());
+  last_source_torque_.assign(torques.size(), 0.0);
+  work_ = Work();
+  ComputeForces(false);
+  e0_ = Energy().Total();
 }
 
-void MultibodySystem::ComputeForces() {
+void MultibodySystem::ComputeForces(bool accumulate) {
   for (RigidBody& b : bodies_) {
     b.w_world = b.R * b.w;
     b.force = b.mass * gravity_ + b.ext_force;
@@ -102,6 +134,21 @@ void MultibodySystem::ComputeForces() {
   for (const auto& e : springs) e.Apply(bodies_);
   for (const auto& e : torques) e.Apply(bodies_);
   for (auto& e : point_contacts) e.Apply(bodies_, step_);
+  // the work ledger: the mean of the last and the present evaluation's force times the motion of
+  // the step that led here (dt v and dt w at the half step)
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const RigidBody& b = bodies_[i];
+    if (accumulate && !b.fixed)
+      work_.external += 0.5 * dt_ * ((last_ext_force_[i] + b.ext_force).dot(b.v) + (last_ext_torque_[i] + b.ext_torque).dot(b.w_world));
+    last_ext_force_[i] = b.ext_force;
+    last_ext_torque_[i] = b.ext_torque;
+  }
+  for (size_t k = 0; k < torques.size(); ++k) {
+    const AxisTorque& t = torques[k];
+    if (!t.source) continue;
+    if (accumulate) work_.sources += 0.5 * dt_ * (last_source_torque_[k] + t.torque) * t.RelativeSpeed(bodies_);
+    last_source_torque_[k] = t.torque;
+  }
   for (RigidBody& b : bodies_) {
     if (b.fixed) continue;
     b.accel = b.inv_mass * b.force;
@@ -135,7 +182,7 @@ void MultibodySystem::BeginStep() {
 
 void MultibodySystem::EndStep() {
   const double h = 0.5 * dt_;
-  ComputeForces();
+  ComputeForces(true);
   for (RigidBody& b : bodies_) {
     if (b.fixed) continue;
     b.v += h * b.accel;  // second half of eq. 3a / 4a

@@ -16,6 +16,8 @@
 #include "dem_mobility/core/scenes/uniaxial_compression.h"
 #include "dem_mobility/core/terrain/dem_soil.h"
 #include "dem_mobility/core/terrain/soil_patch.h"
+#include "dem_mobility/core/terrain/terrain_model.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 namespace dem_mobility::core {
 namespace {
@@ -105,6 +107,12 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
   std::printf("run: %ld steps, %.2f s simulated in %.2f s wall (real-time factor %.2f)\n", r.steps, r.sim_time,
               r.wall_time, r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0);
   return MobilityResultFile(r, p, {}, &run.terrain());
+}
+
+void CheckMobilityScene(const YamlReader& reader) {
+  const MobilityRunParams p = MobilityRunParams::Read(reader);
+  const VehicleSpec spec = VehicleSpec::Load(p.vehicle_file);
+  CheckTerrainModel(p.terrain_file, TerrainVehicleOf(spec), p.terrain_overrides);
 }
 
 ResultFile RunPourScene(const YamlReader& reader, const SceneRunOptions&) {
@@ -201,13 +209,18 @@ ResultFile RunCompressionScene(const YamlReader& reader, const SceneRunOptions&)
 
 const std::vector<SceneKind>& SceneKinds() {
   static const std::vector<SceneKind> kinds = {
-      {"road_slope", "the vehicle accelerating up a grade on a terrain: speed-made-good", &RunMobilityScene},
-      {"soil_slope", "the vehicle accelerating up a grade on a moving DEM soil patch: speed-made-good", &RunMobilityScene},
-      {"dem_pour", "soil preparation: pour, settle, consolidate with a lid, release", &RunPourScene},
-      {"cone_penetrometer", "the cone penetrometer: cone index of a prepared soil", &RunConeScene},
-      {"uniaxial_compression", "piston-cylinder compression: bulk density against pressure", &RunCompressionScene},
+      {"road_slope", "the vehicle accelerating up a grade on a terrain: speed-made-good", &RunMobilityScene,
+       &CheckMobilityScene},
+      {"soil_slope", "the vehicle accelerating up a grade on a moving DEM soil patch: speed-made-good", &RunMobilityScene,
+       &CheckMobilityScene},
+      {"dem_pour", "soil preparation: pour, settle, consolidate with a lid, release", &RunPourScene,
+       [](const YamlReader& y) { DemPourParams::Read(y); }},
+      {"cone_penetrometer", "the cone penetrometer: cone index of a prepared soil", &RunConeScene,
+       [](const YamlReader& y) { ConeParams::Read(y); }},
+      {"uniaxial_compression", "piston-cylinder compression: bulk density against pressure", &RunCompressionScene,
+       [](const YamlReader& y) { CompressionParams::Read(y); }},
       {"single_wheel", "the single-wheel rig: drawbar pull, torque and sinkage of a tire on DEM soil at a slip",
-       &RunSingleWheelScene},
+       &RunSingleWheelScene, [](const YamlReader& y) { SingleWheelParams::Read(y); }},
   };
   return kinds;
 }

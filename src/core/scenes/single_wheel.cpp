@@ -206,6 +206,7 @@ void SingleWheelRig::Step() {
       bin_->PrepareStep();
       if (bin_->prepared()) {
         Place();
+        bin_->WatchEnergy(0.05);  // the soil's energy ledger over the rig's run
         phase_ = Phase::kLoad;
       }
       return;
@@ -325,6 +326,7 @@ ResultFile SingleWheelResultFile(const SingleWheelRig& rig) {
   }
   f.SetStatus(status, error);
   p.bin.Describe(&f);
+  bin.DescribeEnergy(&f);
   f.Set("drive", std::string(SingleWheelParams::DriveName(p.drive)));
   if (p.drive == SingleWheelParams::Drive::kSlip) f.Set("slip_commanded", p.slip);
   if (p.drive == SingleWheelParams::Drive::kTorque) f.Set("torque_commanded", p.torque);

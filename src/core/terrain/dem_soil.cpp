@@ -82,6 +82,7 @@ DemSoilParams DemSoilParams::Read(const YamlReader& y) {
   p.soil.friction = p.friction;
   p.threads = ReadThreads(y);
   p.seed = static_cast<unsigned>(y.Int("seed", 1));
+  p.time_step_guard = y.Bool("time_step_guard", true);
   if (y.Has("bin")) {
     const YamlReader b = y.Child("bin");
     p.origin = b.Vector3("origin", Vector3d::Zero());
@@ -146,6 +147,7 @@ double DemSoilParams::ConeIndex() const {
 
 void DemSoilParams::Describe(ResultFile* r) const {
   r->Set("fidelity", level.name);
+  if (!time_step_guard) r->Set("soil_time_step_guard", false);
   r->Set("particle_diameter", level.particle_diameter);
   r->Set("cohesion_factor", cohesion_factor);
   r->Set("friction", friction);
@@ -171,6 +173,7 @@ DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int whe
   DemSettings st;
   st.threads = p.threads;
   st.max_overlap = p.max_overlap;
+  st.check_time_step = p.time_step_guard;
   // a moving patch re-emits a layer at a time next to the soil's front: room for the new pairs
   if (p.patch.enabled) st.list_slack = 6;
   dem_ = std::make_unique<DemSystem>(p.soil, st);
@@ -301,7 +304,34 @@ DemSoilBin::DemSoilBin(const DemSoilBin& o)
       plate_(o.plate_),
       wall_height_(o.wall_height_),
       surface_(o.surface_),
-      shift_(o.shift_) {}
+      shift_(o.shift_),
+      watch_(o.watch_),
+      watch_every_(o.watch_every_),
+      watch_start_(o.watch_start_) {}
+
+void DemSoilBin::WatchEnergy(double period) {
+  watch_ = LedgerWatch();
+  watch_every_ = std::max(1L, std::lround(period / dem_->dt()));
+  dem_->set_plastic_ledger(true);  // the law's own plastic exchange in the ledger: `dissipated` is the dampers' and friction's
+  watch_start_ = dem_->Energy();
+  watch_.Sample(watch_start_, dem_->time());
+}
+
+void DemSoilBin::DescribeEnergy(ResultFile* r) const {
+  const TimeStepLimit lim = dem_->CriticalTimeStep();
+  r->Set("soil_critical_time_step", lim.dt_crit);
+  r->Set("soil_critical_detail", lim.detail);
+  if (watch_.samples == 0) return;
+  const EnergyReport e = dem_->Energy();
+  r->Set("soil_energy_wall_work", e.wall_work - watch_start_.wall_work);
+  r->Set("soil_energy_exchanged", e.exchanged - watch_start_.exchanged);
+  r->Set("soil_energy_plastic", dem_->plastic_exchange());
+  r->Set("soil_energy_dissipated", watch_.dissipated);
+  r->Set("soil_energy_dissipated_least", watch_.least);
+  r->Set("soil_energy_largest_fall", watch_.largest_fall);
+  r->Set("soil_energy_scale", watch_.Scale());
+  r->Set("soil_energy_samples", watch_.samples);
+}
 
 void DemSoilBin::ShiftZ(double dz) {
   DemSystem& s = *dem_;
@@ -394,6 +424,7 @@ DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire,
                             Vector3d(o.x() + length, o.y() + l.width, z), Vector3d(o.x(), o.y() + l.width, z)};
   surface_mesh_.faces = {{0, 1, 2}, {0, 2, 3}};
   wrenches_.assign(wheels, WheelWrench());
+  bin_->WatchEnergy(0.05);  // the run's energy ledger from here (20 samples per second of soil time)
   prepare_wall_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -459,6 +490,7 @@ void DemSoilTerrain::Describe(ResultFile* r) const {
   r->Set("soil_steps", bin_->dem().step_count());
   r->Set("soil_neighbour_builds", bin_->dem().neighbour_builds());
   r->Set("soil_wall_builds", bin_->dem().wall_builds());
+  bin_->DescribeEnergy(r);
   if (!patch_) return;
   const PatchStats& s = patch_->stats();
   r->Set("patch_following", s.following);
@@ -538,8 +570,9 @@ void DemSoilTerrain::Advance(double dt) {
   advance_wall_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
-                                                 const std::function<bool()>& stop) {
+namespace {
+/// The bin's parameters read from `y` and checked against `vehicle` (the strips on its track).
+DemSoilParams ReadDemSoilFor(const YamlReader& y, const TerrainVehicle& vehicle) {
   const DemSoilParams p = DemSoilParams::Read(y);
   y.String("model");
   y.Finish();
@@ -577,8 +610,16 @@ std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const Terr
                                        " m): the wheels would meet soil not yet laid; at least ", shortest, " m"));
     }
   }
-  return std::make_unique<DemSoilTerrain>(q, vehicle.tire, vehicle.wheels, stop);
+  return q;
 }
+}  // namespace
+
+std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
+                                                 const std::function<bool()>& stop) {
+  return std::make_unique<DemSoilTerrain>(ReadDemSoilFor(y, vehicle), vehicle.tire, vehicle.wheels, stop);
+}
+
+void CheckDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle) { ReadDemSoilFor(y, vehicle); }
 
 TerrainDescription DescribeDemSoilTerrain(const YamlReader& y) {
   const DemSoilParams p = DemSoilParams::Read(y);

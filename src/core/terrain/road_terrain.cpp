@@ -12,23 +12,41 @@
 namespace dem_mobility::core {
 namespace {
 
+struct RoadParams {
+  TerrainDescription description;
+  double length = 0.0, width = 0.0, cell = 0.0, start = 0.0;
+  ContactParams contact;
+};
+
+RoadParams ReadRoad(const YamlReader& y, const TerrainVehicle& vehicle) {
+  RoadParams p;
+  p.description = DescribeRoadTerrain(y);
+  p.length = y.DoubleIn("length", 1.0, 1e5);
+  p.width = y.DoubleIn("width", 3.0, 1000.0);
+  p.cell = y.DoubleIn("cell", 0.05, 100.0);
+  p.start = y.DoubleIn("start_x", -1e5, 1e5);
+  const double cells = std::ceil(p.length / p.cell) * std::ceil(p.width / p.cell);
+  if (cells > 1e7)
+    y.Fail("cell", detail::Concat("a ", p.length, " x ", p.width, " m road in cells of ", p.cell, " m has ", cells,
+                                  " cells, more than 1e7: a larger cell or a shorter road"));
+  const YamlReader c = y.Child("contact");
+  p.contact = ContactParams::Read(c);
+  c.Finish();
+  y.Finish();
+  DM_THROW_UNLESS(vehicle.wheels == kWheels, y.file(), ": rigid_road carries ", kWheels, " wheels, not ",
+                  vehicle.wheels);
+  return p;
+}
+
 class RoadTerrain final : public TerrainModel {
  public:
   RoadTerrain(const YamlReader& y, const TerrainVehicle& vehicle) : tire_(vehicle.tire) {
-    description_ = DescribeRoadTerrain(y);
-    const double length = y.Positive("length");
-    const double width = y.DoubleIn("width", 3.0, 1000.0);
-    half_width_ = 0.5 * width;
+    const RoadParams p = ReadRoad(y, vehicle);
+    const ContactParams& params = p.contact;
+    description_ = p.description;
+    half_width_ = 0.5 * p.width;
     file_ = y.file();
-    const double cell = y.Positive("cell");
-    const double start = y.Double("start_x");
-    const YamlReader c = y.Child("contact");
-    const ContactParams params = ContactParams::Read(c);
-    c.Finish();
-    y.Finish();
-    DM_THROW_UNLESS(vehicle.wheels == kWheels, y.file(), ": rigid_road carries ", kWheels, " wheels, not ",
-                    vehicle.wheels);
-    mesh_ = std::make_unique<TerrainMesh>(MakeFlatRoad(start, length, width, cell), cell, 0.05);
+    mesh_ = std::make_unique<TerrainMesh>(MakeFlatRoad(p.start, p.length, p.width, p.cell), p.cell, 0.05);
     bodies_.resize(kWheels);
     for (int i = 0; i < kWheels; ++i) {
       bodies_[i].name = std::string("wheel_") + kWheelNames[i];
@@ -98,6 +116,8 @@ TerrainDescription DescribeRoadTerrain(const YamlReader& y) {
   d.cone_index = y.DoubleIn("cone_index_psi", 1.0, 1000.0);
   return d;
 }
+
+void CheckRoadTerrain(const YamlReader& y, const TerrainVehicle& vehicle) { ReadRoad(y, vehicle); }
 
 std::unique_ptr<TerrainModel> MakeRoadTerrain(const YamlReader& y, const TerrainVehicle& vehicle) {
   return std::make_unique<RoadTerrain>(y, vehicle);

@@ -16,12 +16,12 @@ const std::vector<TerrainKind>& TerrainKinds() {
   static const std::vector<TerrainKind> kinds = {
       {"rigid_road", "a rigid polygonal road (tire vertices against its triangles, asperity friction)",
        [](const YamlReader& y, const TerrainVehicle& v, const std::function<bool()>&) { return MakeRoadTerrain(y, v); },
-       &DescribeRoadTerrain},
+       &DescribeRoadTerrain, &CheckRoadTerrain},
       {"dem_soil", "a DEM soil bin (cohesive particles, prepared under a lid) the tires sink into",
        [](const YamlReader& y, const TerrainVehicle& v, const std::function<bool()>& stop) {
          return MakeDemSoilTerrain(y, v, stop);
        },
-       &DescribeDemSoilTerrain},
+       &DescribeDemSoilTerrain, &CheckDemSoilTerrain},
   };
   return kinds;
 }
@@ -46,6 +46,13 @@ std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, 
                                                const std::vector<std::string>& overrides, const std::function<bool()>& stop) {
   const YamlReader y = YamlReader::LoadWithOverrides(terrain_file, overrides);
   return FindTerrainKind(y).make(y, vehicle, stop);
+}
+
+void CheckTerrainModel(const YamlReader& y, const TerrainVehicle& vehicle) { FindTerrainKind(y).check(y, vehicle); }
+
+void CheckTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
+                       const std::vector<std::string>& overrides) {
+  CheckTerrainModel(YamlReader::LoadWithOverrides(terrain_file, overrides), vehicle);
 }
 
 TerrainDescription DescribeTerrain(const std::string& terrain_file, const std::vector<std::string>& overrides) {

@@ -1,6 +1,8 @@
 #include "dem_mobility/core/vehicle/vehicle.h"
 
 #include <Eigen/Geometry>
+#include <Eigen/QR>
+#include <map>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -28,8 +30,81 @@ Vector3d Vehicle::ChassisFramePosition() const {
 }
 void Vehicle::SetSteering(double fraction) {
   // the rack moving to +y (the vehicle's left) turns the wheels to the right
-  if (rack_ >= 0)
-    system_.line_constraints[rack_].target = -std::clamp(fraction, -1.0, 1.0) * spec_.steering.max_rack_travel;
+  if (rack_ < 0) return;
+  LineConstraint& rack = system_.line_constraints[rack_];
+  const double target = -std::clamp(fraction, -1.0, 1.0) * spec_.steering.max_rack_travel;
+  if (target == rack.target) return;
+  // moving the servo's target changes its spring's energy at fixed positions: the servo's work
+  const double before = rack.PotentialEnergy(system_.bodies());
+  rack.target = target;
+  servo_work_ += rack.PotentialEnergy(system_.bodies()) - before;
+}
+
+void Vehicle::SetRollingSpeed(double v) {
+  MultibodySystem& sys = system_;
+  // the spinning bodies (in couplings and CV joints) and each one's spin axis in its frame
+  std::map<int, int> unknown;
+  std::vector<int> body_of;
+  std::vector<Vector3d> axis_of;
+  const auto add = [&](int b, const Vector3d& axis) {
+    if (b == 0 || unknown.count(b)) return;
+    unknown[b] = static_cast<int>(body_of.size());
+    body_of.push_back(b);
+    axis_of.push_back(axis.normalized());
+  };
+  for (int i = 0; i < 4; ++i) add(wheels_[i], Vector3d::UnitY());
+  for (const RotationalCoupling& c : sys.couplings)
+    for (const auto& t : c.terms) add(t.body, t.axis);
+  for (const CvTwist& c : sys.cv_twists) {
+    add(c.a, c.ua);
+    add(c.b, c.ub);
+  }
+  const int n = static_cast<int>(body_of.size());
+  const int rows = 4 + static_cast<int>(sys.couplings.size() + sys.cv_twists.size());
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(rows, n);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(rows);
+  int r = 0;
+  for (int i = 0; i < 4; ++i, ++r) {  // each wheel rolls: spin v / r about its axle (+y)
+    A(r, unknown[wheels_[i]]) = 1.0;
+    rhs(r) = v / spec_.tire.radius;
+  }
+  for (const RotationalCoupling& c : sys.couplings) {  // sum coeff x spin about the term's axis = 0
+    for (const auto& t : c.terms) A(r, unknown[t.body]) += t.coeff * axis_of[unknown[t.body]].dot(t.axis.normalized());
+    ++r;
+  }
+  for (const CvTwist& c : sys.cv_twists) {  // equal spins of the two shafts about their mean axis
+    const RigidBody &a = sys.body(c.a), &b = sys.body(c.b);
+    const Vector3d m = (a.R * c.ua + b.R * c.ub).normalized();
+    A(r, unknown[c.b]) += (b.R * axis_of[unknown[c.b]]).dot(m);
+    A(r, unknown[c.a]) -= (a.R * axis_of[unknown[c.a]]).dot(m);
+    ++r;
+  }
+  const Eigen::VectorXd spin = A.colPivHouseholderQr().solve(rhs);
+  DM_DEMAND(spin.allFinite() && (A * spin - rhs).norm() <= 1e-9 * (1.0 + rhs.norm()));
+  for (int i = 1; i < sys.num_bodies(); ++i) {
+    RigidBody& b = sys.mutable_body(i);
+    if (b.fixed) continue;
+    b.v = Vector3d(v, 0.0, 0.0);  // (as built: every R = I, the chassis x axis is the world x)
+    b.w.setZero();
+    b.w_world.setZero();
+  }
+  for (int k = 0; k < n; ++k) {
+    RigidBody& b = sys.mutable_body(body_of[k]);
+    b.w = spin(k) * axis_of[k];
+    b.w_world = b.R * b.w;
+  }
+}
+
+EnergyReport Vehicle::Energy() const {
+  EnergyReport e = system_.Energy();
+  for (int i = 0; i < 4; ++i) {
+    const double stretch = brake_angle_[i] - brake_anchor_[i];
+    e.elastic += 0.5 * spec_.powertrain.brake_stiffness * stretch * stretch;
+  }
+  e.wall_work = system_.work().external;
+  e.exchanged = system_.work().sources + servo_work_;
+  e.dissipated = e.wall_work + e.exchanged - (e.Total() - system_.initial_energy());
+  return e;
 }
 
 double Vehicle::Heading() const {
@@ -62,23 +137,21 @@ void Vehicle::SetWheelWrench(int i, const WheelWrench& w) {
   b.ext_torque = w.moment;
 }
 
-TimeStepLimit Vehicle::WheelContactLimit(double stiffness, double damping) const {
-  TimeStepLimit lim;
-  lim.dt_crit = std::numeric_limits<double>::infinity();
-  if (stiffness <= 0.0) return lim;
+std::vector<MultibodySystem::BodyMode> Vehicle::WheelContactModes(double stiffness, double damping) const {
+  std::vector<MultibodySystem::BodyMode> modes;
+  if (!(stiffness > 0.0)) return modes;
   for (int i = 0; i < 4; ++i) {
     const RigidBody& b = system_.body(wheels_[i]);
-    const double w2 = stiffness * InverseEffectiveMass(b, Vector3d(0, 0, spec_.tire.radius));
-    const double zeta = damping * std::sqrt(w2) / (2.0 * stiffness);
-    const double dt = CriticalStep(std::sqrt(w2), zeta);
-    if (dt < lim.dt_crit) {
-      lim.dt_crit = dt;
-      lim.element = std::string("wheel-terrain contact 'tire_") + kWheelNames[i] + "'";
-      lim.detail = detail::Concat("terrain contact stiffness ", stiffness, " N/m, damping ", damping, " N s/m on '",
-                                  b.name, "' ", b.mass, " kg");
-    }
+    MultibodySystem::BodyMode m;
+    m.body = wheels_[i];
+    m.name = std::string("wheel-terrain contact 'tire_") + kWheelNames[i] + "'";
+    m.mode.omega = std::sqrt(stiffness * InverseEffectiveMass(b, Vector3d(0, 0, spec_.tire.radius)));
+    m.mode.zeta = damping * m.mode.omega / (2.0 * stiffness);
+    m.mode.detail = detail::Concat("terrain contact stiffness ", stiffness, " N/m, damping ", damping, " N s/m on '",
+                                   b.name, "' ", b.mass, " kg");
+    modes.push_back(m);
   }
-  return lim;
+  return modes;
 }
 
 }  // namespace dem_mobility::core

@@ -322,6 +322,7 @@ void VehicleAssembler::DriveShaft() {
   drive.housing = chassis;
   drive.body = shaft;
   drive.axis = Vector3d::UnitX();
+  drive.source = true;  // the engine
   vehicle_->drive_ = static_cast<int>(system_.torques.size());
   system_.torques.push_back(drive);
 }

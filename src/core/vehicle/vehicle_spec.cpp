@@ -179,9 +179,10 @@ void CheckHalfShafts(const VehicleSpec& spec, const YamlReader& driveline) {
 
 }  // namespace
 
-VehicleSpec VehicleSpec::Load(const std::string& file) {
+VehicleSpec VehicleSpec::Load(const std::string& file, const YamlOpener& opener) {
+  const YamlOpener open = opener ? opener : YamlOpener(&YamlReader::Load);
   VehicleSpec spec;
-  const YamlReader top = YamlReader::Load(file);
+  const YamlReader top = open(file);
   spec.name = top.String("name");
   spec.wheelbase = top.Positive("wheelbase");
   const YamlReader penalty = top.Child("penalty");
@@ -189,12 +190,12 @@ VehicleSpec VehicleSpec::Load(const std::string& file) {
   spec.rotational_penalty = ReadPenalty(penalty.Child("rotational"));
   penalty.Finish();
 
-  const YamlReader suspension_front = YamlReader::Load(top.ResolvePath(top.String("suspension_front")));
-  const YamlReader suspension_rear = YamlReader::Load(top.ResolvePath(top.String("suspension_rear")));
-  const YamlReader steering = YamlReader::Load(top.ResolvePath(top.String("steering")));
-  const YamlReader driveline = YamlReader::Load(top.ResolvePath(top.String("driveline")));
-  const YamlReader powertrain = YamlReader::Load(top.ResolvePath(top.String("powertrain")));
-  const YamlReader tire = YamlReader::Load(top.ResolvePath(top.String("tire")));
+  const YamlReader suspension_front = open(top.ResolvePath(top.String("suspension_front")));
+  const YamlReader suspension_rear = open(top.ResolvePath(top.String("suspension_rear")));
+  const YamlReader steering = open(top.ResolvePath(top.String("steering")));
+  const YamlReader driveline = open(top.ResolvePath(top.String("driveline")));
+  const YamlReader powertrain = open(top.ResolvePath(top.String("powertrain")));
+  const YamlReader tire = open(top.ResolvePath(top.String("tire")));
   spec.powertrain = PowertrainParams::Read(powertrain);
   spec.tire = ReadTire(tire);
   spec.driveline = ReadDriveline(driveline);

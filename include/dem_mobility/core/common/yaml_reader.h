@@ -5,6 +5,8 @@
 #include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -21,7 +23,10 @@ namespace dem_mobility::core {
 /// a configuration file is an error instead of a silently ignored setting.
 class YamlReader {
  public:
-  /// Loads `path`; throws ConfigError naming the file when it is missing or malformed.
+  /// The largest configuration file Load reads (the shipped ones are under 20 kB).
+  static constexpr std::uintmax_t kMaxFileBytes = 16u << 20;
+  /// Loads `path`; throws ConfigError naming the file when it is missing, not a regular file,
+  /// larger than kMaxFileBytes or malformed.
   static YamlReader Load(const std::string& path);
   /// Loads `path` and applies `key=value` overrides (dotted keys for nested maps: driver.kp=4000);
   /// a value is parsed as YAML. An override of a key (or map) the file lacks is added, so the
@@ -75,6 +80,8 @@ class YamlReader {
 
  private:
   YAML::Node Get(const std::string& key) const;
+  /// A key of this map as text; ConfigError for a key that is a list or a map.
+  std::string KeyText(const YAML::Node& key) const;
   template <typename T>
   T As(const std::string& key, const YAML::Node& n, const char* what) const;
 
@@ -83,5 +90,9 @@ class YamlReader {
   std::string path_;
   std::shared_ptr<std::set<std::string>> used_;
 };
+
+/// Opens a configuration file by its path: YamlReader::Load, or (the fuzz harnesses) text given in
+/// place of one of the files a loader chains to.
+using YamlOpener = std::function<YamlReader(const std::string& path)>;
 
 }  // namespace dem_mobility::core

@@ -43,8 +43,6 @@ class VehicleCoSim {
   long last_exchange_step() const { return last_exchange_; }
   const std::vector<WheelState>& wheel_states() const { return states_; }
   const std::vector<WheelWrench>& wheel_wrenches() const { return wrenches_; }
-  /// Gravity for a grade of `deg` uphill toward +x (the terrain frame is the slope frame).
-  static Eigen::Vector3d GradeGravity(double deg);
 
  private:
   void Exchange(TerrainPort& terrain);

@@ -21,6 +21,10 @@ struct DemEnergyTerms {
 
 /// The elastic energy of listed pair k of slot i.
 double PairEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists, int i, int k);
+/// The normal branches' energy (repulsion, the adhesion triangle) of a contact of overlap `d` (the
+/// plastic deformations taken off) and largest adhesion `fmax`: the part the law's plastic changes
+/// move.
+double NormalEnergy(const SoilContactLaw& law, double d, double fmax);
 /// Kinetic, gravitational and elastic energy of all live particles.
 EnergyReport MechanicalEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists);
 /// Slot i's kinetic and gravitational energy and that of all its pairs (what it takes away when removed).
@@ -30,7 +34,11 @@ double ParticleEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const Ne
 struct DemLedger {
   double e0 = 0.0;          ///< mechanical energy at Finalize
   double wall_work = 0.0;   ///< the walls' work on the particles (trapezoidal in time)
-  double exchanged = 0.0;   ///< particles added less removed, gravity changes
+  double exchanged = 0.0;   ///< particles added less removed, gravity changes, and `plastic`
+  /// the contact law's own changes at fixed positions: the plastic deformations and the adhesion
+  /// that follows them, changed after a step (compaction takes energy, relaxation gives it back);
+  /// kept only while DemSystem::set_plastic_ledger(true)
+  double plastic = 0.0;
   double wall_power = 0.0;  ///< the walls' power at the last force evaluation
 };
 

@@ -49,6 +49,9 @@ struct DemSettings {
   double max_overlap = 0.25;    ///< watchdog: largest overlap / diameter before the run stops (the
                                 ///< soil sits at d0 = 5 % and compacts plastically by up to ~8 % more)
   int max_coordination = 12;    ///< contacts per particle assumed by the time-step guard
+  /// the guard: Finalize refuses a step above the critical one (false only for stability studies,
+  /// which run past it to see what the guard prevents)
+  bool check_time_step = true;
   int list_slack = 2;           ///< spare neighbour slots per particle for particles added later
   bool wall_bins = true;        ///< bin large walls' triangles (false: scan them all; same results)
   /// the pair kernel (pair_sweep.h): every choice gives the same results, bit for bit
@@ -144,6 +147,12 @@ class DemSystem {
   DemContactSummary ContactSummary() const;
   /// The energies now and the ledger since Finalize() (see EnergyReport: the ledger is kept).
   EnergyReport Energy() const;
+  /// Keeps the contact law's plastic exchange in the ledger (DemLedger::plastic, in `exchanged`):
+  /// then `dissipated` is what the dampers and the friction took, never negative in a stable run.
+  /// Off by default (a pass over the pairs after every step in which a plastic deformation changed).
+  void set_plastic_ledger(bool on) { plastic_ledger_ = on; }
+  /// The law's plastic exchange since set_plastic_ledger(true) [J].
+  double plastic_exchange() const { return ledger_.plastic; }
   /// Bytes held for the particles, neighbour lists, contact histories and walls.
   size_t MemoryBytes() const;
   Eigen::Vector3d Momentum() const;
@@ -151,6 +160,8 @@ class DemSystem {
  private:
   void Rebuild();
   void ComputeForces();
+  /// Adds the step's plastic changes' energy to the ledger (set_plastic_ledger).
+  void PlasticExchange();
   /// The threads a pass runs on (settings_.serial_below).
   int Threads() const { return ps_.slots() < settings_.serial_below ? 1 : settings_.threads; }
   DemEnergyTerms EnergyTerms() const { return DemEnergyTerms{&law_, soil_.diameter, mass_, gravity_}; }
@@ -167,6 +178,11 @@ class DemSystem {
   NeighbourList lists_;
   WallContacts walls_;
   DemLedger ledger_;
+  bool plastic_ledger_ = false;
+  // the plastic pass's scratch (per slot: the deformation and adhesion before the step's change,
+  // whether it changed, the energy change of its half list's pairs), grown with the slots
+  std::vector<double> plastic_before_, adhesion_before_, plastic_de_;
+  std::vector<char> plastic_changed_;
 };
 
 }  // namespace dem_mobility::core

@@ -4,12 +4,14 @@
 // the loop that produces them is the co-simulation's (cosim/cosim_loop.h).
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "dem_mobility/core/common/energy.h"
 #include "dem_mobility/core/cosim/exchange.h"
 #include "dem_mobility/core/vehicle/driver.h"
 
@@ -39,10 +41,20 @@ struct MobilityRunParams {
   /// cone_index, fidelity, threads, seed)
   std::vector<std::string> terrain_overrides;
   double grade_deg = 0.0;
+  /// [deg] a side slope across the grade: the left (+y) side higher, gravity pulling to -y
+  double side_slope_deg = 0.0;
+  /// [m] the vehicle starts this high above its resting place (a drop onto the terrain)
+  double start_height = 0.0;
+  /// [m/s] the vehicle starts rolling at this speed along x, every shaft and wheel turning with
+  /// it (Vehicle::SetRollingSpeed): a vehicle arriving on the terrain at speed
+  double start_speed = 0.0;
   double duration = 40.0;
   double settle_time = 0.5;   ///< [s] brakes on, driver off, before the driver's t = 0
   double time_step = 0.0;     ///< 0: auto = time_step_safety x critical step
-  double time_step_safety = 0.5;
+  double time_step_safety = 0.9;  // of the guard's bound (MultibodySystem::CriticalTimeStep)
+  /// `time_step_guard: false`: a time_step above the critical step runs (stability studies only:
+  /// docs/stability.md); the result says so
+  bool time_step_guard = true;
   int coupling_interval = 1;  ///< vehicle steps per terrain exchange (wrenches held in between)
   DriverParams driver;
   PlateauParams plateau;
@@ -50,6 +62,9 @@ struct MobilityRunParams {
   bool end_when_steady = false;  ///< end the run once the detector finds a plateau or the command reached
   /// Reads a scene file of kind `road_slope` or `soil_slope`; ConfigError names the file and key.
   static MobilityRunParams Read(const YamlReader& y);
+  /// Gravity in the slope frame (x uphill, z the terrain's normal): the grade about y, the side
+  /// slope about x.
+  Eigen::Vector3d Gravity() const;
 };
 
 /// One history sample (t from the driver's start).
@@ -85,7 +100,7 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
 struct SteadyFigures {
   int samples = 0;
   std::array<double, kWheels> slip{}, sinkage{};
-  double traction_coefficient = 0.0;   ///< terrain pull / (m g cos(grade))
+  double traction_coefficient = 0.0;   ///< terrain pull / (m g cos(grade) cos(side slope))
   double motion_resistance = 0.0;      ///< (thrust - pull) / (m g cos(grade))
   double drawbar_margin = 0.0;         ///< traction_coefficient - tan(grade)
 };
@@ -100,6 +115,10 @@ struct MobilityRunResult {
   double dt = 0.0, dt_crit = 0.0;
   std::string dt_limit_element;
   int coupling_interval = 1;  ///< vehicle steps per exchange in use
+  /// The vehicle's energy ledger at the end, and followed along the run (every history sample's
+  /// step, settling included, from the first step on)
+  EnergyReport vehicle_energy;
+  LedgerWatch vehicle_ledger;
   long steps = 0, exchanges = 0, driver_updates = 0;
   double sim_time = 0.0, wall_time = 0.0;  ///< sim_time: from the driver's start
   bool ended_early = false;
@@ -110,7 +129,8 @@ struct MobilityRunResult {
 };
 
 /// The steady figures over the trailing `window` of the history (vehicle mass m, grade).
-SteadyFigures SteadyWindowFigures(const std::vector<MobilitySample>& h, double window, double mass, double grade_deg);
+SteadyFigures SteadyWindowFigures(const std::vector<MobilitySample>& h, double window, double mass, double grade_deg,
+                                  double side_slope_deg = 0.0);
 
 /// The run's result file (speed-made-good, status, terrain, timing); `published` lists message
 /// counts by topic (the ROS run's); `terrain`: the terrain model that ran, when in this process

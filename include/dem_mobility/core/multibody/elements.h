@@ -146,6 +146,7 @@ struct AxisTorque {
   int housing = 0, body = 0;
   Eigen::Vector3d axis;     ///< unit axis in body b coordinates
   double torque = 0.0;      ///< applied on b about axis; -torque on h
+  bool source = false;      ///< an energy source (an engine): its work is in MultibodySystem::work()
   double RelativeSpeed(const Bodies& bodies) const;
   void Apply(Bodies& bodies) const;
 };

@@ -49,9 +49,22 @@ class MultibodySystem {
   /// (for controllers that set AxisTorque values from the current state).
   std::function<void(MultibodySystem&)> pre_force_hook;
 
-  /// The time-step guard: the critical step of every element from its stiffness and the bodies it
-  /// connects (omega^2 = k (1/m_a + 1/m_b), damping factor sqrt(1+z^2)-z); returns the smallest.
-  TimeStepLimit CriticalTimeStep() const;
+  /// A mode acting on one body from outside the elements (a terrain contact on a wheel).
+  struct BodyMode {
+    int body = 0;
+    std::string name;
+    StiffnessInfo mode;
+  };
+  /// The time-step guard. Each element's own mode has omega_e^2 = k (1/m_a + 1/m_b) (the inverse
+  /// masses of its bodies in its worst direction); the elements on one body act on it together, and
+  /// the system's highest frequency is at most the largest over the bodies of sqrt(sum of omega_e^2
+  /// of the elements on the body) (Cauchy-Schwarz on each element's energy: k |J_a q_a - J_b q_b|^2
+  /// <= omega_e^2 (|q_a|_M^2 + |q_b|_M^2)). So the critical step is the smallest over the bodies of
+  /// (2 / omega)(sqrt(1 + zeta^2) - zeta) at that omega, zeta the largest damping ratio among the
+  /// body's elements: a bound that holds for the assembled system, where the stiffest element alone
+  /// is not one (the vehicle blew up at 0.7 of that element's step: docs/stability.md). `extra`:
+  /// modes on bodies from outside (a terrain's contact on the wheels).
+  TimeStepLimit CriticalTimeStep(const std::vector<BodyMode>& extra = {}) const;
   /// Refuses (ConfigError naming the element and the limit) a dt above the critical step, then
   /// computes the forces at the initial state. `check_step = false` skips the guard (only for
   /// stability studies such as the integrator tests).
@@ -69,14 +82,32 @@ class MultibodySystem {
   long step_count() const { return step_; }
   double dt() const { return dt_; }
   EnergyReport Energy() const;
+  /// The work done on the system since Finalize by what is outside it: the external wrenches
+  /// (ext_force, ext_torque: a terrain's) and the AxisTorques marked as sources (an engine). Each
+  /// step adds the mean of a force's values at the step's two evaluations times the step's motion
+  /// (dt times the half-step velocity): the form in which velocity Verlet's kinetic energy follows
+  /// the work exactly, so that Energy() less the energy at Finalize less this work is what the
+  /// dampers, brakes and friction took, down to the integrator's error.
+  struct Work {
+    double external = 0.0;  ///< ext_force and ext_torque [J]
+    double sources = 0.0;   ///< AxisTorques with source = true [J]
+  };
+  const Work& work() const { return work_; }
+  /// Energy().Total() at Finalize [J].
+  double initial_energy() const { return e0_; }
   /// Total mass of the movable bodies and their centre of mass.
   double TotalMass() const;
   Eigen::Vector3d CenterOfMass() const;
 
  private:
-  void ComputeForces();
+  /// The forces at the current state; `accumulate`: add the step's work to work_ (not at Finalize).
+  void ComputeForces(bool accumulate);
   void CheckFinite() const;
   Bodies bodies_;
+  Work work_;
+  double e0_ = 0.0;
+  std::vector<Eigen::Vector3d> last_ext_force_, last_ext_torque_;  ///< at the previous evaluation
+  std::vector<double> last_source_torque_;
   Eigen::Vector3d gravity_{0, 0, -9.81};
   double dt_ = 0.0, time_ = 0.0;
   long step_ = 0;

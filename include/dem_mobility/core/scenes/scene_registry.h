@@ -29,6 +29,9 @@ struct SceneKind {
   /// Reads the scene (ConfigError for bad input) and runs it. A numerical failure does not throw:
   /// the result says status error, with what was measured so far.
   std::function<ResultFile(const YamlReader& scene_file, const SceneRunOptions& options)> run;
+  /// Reads and checks the scene and every file it names as `run` does before it starts, and runs
+  /// nothing (no soil is prepared): ConfigError for bad input (dm_run_scene --check).
+  std::function<void(const YamlReader& scene_file)> check;
 };
 
 const std::vector<SceneKind>& SceneKinds();

@@ -7,6 +7,8 @@
 // scene's frame (x forward, z up); a grade is the scene's rotated gravity, as on the road.
 #pragma once
 
+#include "dem_mobility/core/common/energy.h"
+
 #include <Eigen/Core>
 #include <functional>
 #include <limits>
@@ -83,6 +85,9 @@ struct DemSoilParams {
   SoilPatchParams patch;
   int threads = 1;
   unsigned seed = 1;
+  /// `time_step_guard: false`: the level's time step runs even above the soil's critical step
+  /// (stability studies only: docs/stability.md)
+  bool time_step_guard = true;
   double max_overlap = 0.4;         ///< overlap watchdog, fraction of d
   /// [m] `track_strip_width`: > 0, soil only in two strips this wide centred under the wheel tracks
   /// (at y = +-strip_offset from the bin's centre line), each between walls of its own, with a
@@ -129,8 +134,19 @@ class DemSoilBin {
   void SetWheel(int k, const WheelState& s);
   /// The soil's wrench on tire k from the last force evaluation, about the centre it was set to.
   WheelWrench Wrench(int k) const;
-  /// One DEM step.
-  void Step() { dem_->Step(); }
+  /// One DEM step (and a sample of the soil's energy ledger when it is followed).
+  void Step() {
+    dem_->Step();
+    if (watch_every_ > 0 && dem_->step_count() % watch_every_ == 0) watch_.Sample(dem_->Energy(), dem_->time());
+  }
+  /// Follows the soil's energy ledger from now on (a run's start, after the preparation): a sample
+  /// now and every `period` seconds of soil time (LedgerWatch).
+  void WatchEnergy(double period);
+  const LedgerWatch& energy_watch() const { return watch_; }
+  /// The soil's critical step (soil_critical_time_step, _detail) and the watch in a result:
+  /// soil_energy_dissipated, _least, _largest_fall, _scale, _samples, and the wall work and
+  /// exchanged energy since the watch began.
+  void DescribeEnergy(ResultFile* r) const;
 
   DemSystem& dem() { return *dem_; }
   const DemSystem& dem() const { return *dem_; }
@@ -159,6 +175,9 @@ class DemSoilBin {
   std::vector<Eigen::Vector3d> centres_;
   int lid_ = -1, cylinder_ = -1, plate_ = -1;
   double wall_height_ = 0.0, surface_ = 0.0, shift_ = 0.0;
+  LedgerWatch watch_;
+  long watch_every_ = 0;
+  EnergyReport watch_start_;
 };
 
 class SoilPatch;
@@ -212,5 +231,7 @@ class DemSoilTerrain final : public TerrainModel {
 std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
                                                  const std::function<bool()>& stop = {});
 TerrainDescription DescribeDemSoilTerrain(const YamlReader& y);
+/// Reads and checks the bin's keys for `vehicle` as MakeDemSoilTerrain does, preparing no soil.
+void CheckDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle);
 
 }  // namespace dem_mobility::core

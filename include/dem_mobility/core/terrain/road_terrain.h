@@ -11,5 +11,7 @@ namespace dem_mobility::core {
 
 std::unique_ptr<TerrainModel> MakeRoadTerrain(const YamlReader& y, const TerrainVehicle& vehicle);
 TerrainDescription DescribeRoadTerrain(const YamlReader& y);
+/// Reads and checks the road's keys for `vehicle`, building no mesh.
+void CheckRoadTerrain(const YamlReader& y, const TerrainVehicle& vehicle);
 
 }  // namespace dem_mobility::core

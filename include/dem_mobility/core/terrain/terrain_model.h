@@ -85,6 +85,9 @@ struct TerrainKind {
                                               const std::function<bool()>& stop)>
       make;
   std::function<TerrainDescription(const YamlReader& file)> describe;
+  /// Reads and checks every key of the file for `vehicle` as `make` does, building nothing
+  /// (no soil is prepared): ConfigError for what `make` would refuse before it starts.
+  std::function<void(const YamlReader& file, const TerrainVehicle& vehicle)> check;
 };
 
 /// The terrain kinds there are.
@@ -98,6 +101,12 @@ const std::vector<TerrainKind>& TerrainKinds();
 std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
                                                const std::vector<std::string>& overrides = {},
                                                const std::function<bool()>& stop = {});
+/// Reads and checks `terrain_file` (with overrides) for `vehicle` as LoadTerrainModel does, building
+/// nothing: the check of `dm_run_scene --check`.
+void CheckTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
+                       const std::vector<std::string>& overrides = {});
+/// The same for a terrain file already read (the fuzz harness's text).
+void CheckTerrainModel(const YamlReader& terrain_file, const TerrainVehicle& vehicle);
 /// What `terrain_file` describes (model, cone index, time step, level), without building it.
 TerrainDescription DescribeTerrain(const std::string& terrain_file, const std::vector<std::string>& overrides = {});
 

@@ -56,16 +56,33 @@ class Vehicle {
   WheelState GetWheelState(int i) const;
   /// Applies the terrain's wrench on wheel i (world frame, about its centre) from now on.
   void SetWheelWrench(int i, const WheelWrench& w);
-  /// The time-step limit of a wheel-terrain contact with the given stiffness and damping on the
-  /// lightest wheel (in its worst direction: the contact point on the rim).
-  TimeStepLimit WheelContactLimit(double stiffness, double damping) const;
+  /// The modes of a wheel-terrain contact with the given stiffness and damping on each wheel (in
+  /// its worst direction: the contact point on the rim), for the guard (MultibodySystem::
+  /// CriticalTimeStep's `extra`: on each wheel with its joints).
+  std::vector<MultibodySystem::BodyMode> WheelContactModes(double stiffness, double damping) const;
+  /// The whole vehicle's time-step limit with that contact on its wheels.
+  TimeStepLimit CriticalTimeStep(double contact_stiffness, double contact_damping) const {
+    return system_.CriticalTimeStep(WheelContactModes(contact_stiffness, contact_damping));
+  }
 
   void SetDriveTorqueRequest(double t) { drive_request_ = t; }
   void SetBrakeEffort(double effort) { brake_effort_ = effort; }
+  /// Sets every body moving at `v` along the chassis x axis (the vehicle as built, R = I), the
+  /// wheels rolling at v / r and every shaft and gear of the driveline turning as its couplings
+  /// and CV joints require (a least-squares solve of their rates with the wheels' spins given):
+  /// a vehicle arriving at speed, no coupling or joint strained by it.
+  void SetRollingSpeed(double v);
   /// Steering: the rack's position servo to `fraction` of full lock (max_rack_travel; + left).
   void SetSteering(double fraction);
   double AppliedDriveTorque() const;
   double BrakeEffort() const { return brake_effort_; }
+
+  /// The vehicle's energy and its ledger since the system's Finalize: `elastic` includes the brakes'
+  /// stick springs; `wall_work` is the terrain's work on the wheels, `exchanged` the engine's work
+  /// on the drive shaft and the steering servo's (its rack target moved); `dissipated` = wall_work
+  /// + exchanged - (Total() - Total() at Finalize): what the dampers, brakes and differentials
+  /// took. Never negative beyond the integrator's error in a stable run.
+  EnergyReport Energy() const;
 
  private:
   friend class VehicleAssembler;
@@ -82,6 +99,7 @@ class Vehicle {
   Eigen::Vector3d chassis_com_offset_ = Eigen::Vector3d::Zero();
   double ride_height_ = 0.0;
   double drive_request_ = 0.0, brake_effort_ = 0.0;
+  double servo_work_ = 0.0;       ///< the steering servo's work: its springs' energy when the target moved
   int rack_ = -1;                 ///< index into system_.line_constraints (the rack's prismatic joint)
   std::array<WheelWrench, 4> wrench_{};
 };

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "dem_mobility/core/common/table.h"
+#include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/geometry/tire_geometry.h"
 #include "dem_mobility/core/vehicle/powertrain.h"
 
@@ -110,8 +111,9 @@ struct VehicleSpec {
   TireGeometry tire;
 
   /// Reads `file` and the files it names; throws ConfigError naming the file, the key path and the
-  /// value of any bad, missing or unknown input.
-  static VehicleSpec Load(const std::string& file);
+  /// value of any bad, missing or unknown input. `open` (empty: YamlReader::Load) opens `file` and
+  /// each file it names.
+  static VehicleSpec Load(const std::string& file, const YamlOpener& open = {});
 
   const SuspensionSpec& suspension(int axle) const { return axle == 0 ? suspension_front : suspension_rear; }
   /// Mass of the parts the chassis carries (rack, drive shaft, both axles' differential bodies).
