@@ -16,8 +16,8 @@
 #   ./scripts/sanitize.sh TEST...         the test programs named (targets of test/core)
 #   ./scripts/sanitize.sh --fuzz TARGET [SECONDS]   one harness for longer (default 600 s); its
 #                                         corpus grows in $DM_BUILD/sanitize/fuzz/corpus/TARGET
-# The timing tests of config_test (a signal 1-3 s into a run) assume a build at full speed: they
-# are left out here. vehicle_test runs some 30 times slower under the sanitizers (its climbs take
+# The timing tests of config_test (a signal 1-3 s into a run) assume a build at full speed, and
+# its full-disk road run takes 1.5 min under the sanitizers: they are left out here. vehicle_test runs some 30 times slower under the sanitizers (its climbs take
 # minutes each): name it to run it.
 source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_SANITIZE_PACKAGES[@]}"
@@ -33,7 +33,7 @@ case "${1:-}" in
     fuzz_seconds="${3:-600}"
     [[ " ${fuzz_targets[*]} " == *" $fuzz_only "* ]] || { echo "sanitize.sh: no fuzz target '$fuzz_only' (${fuzz_targets[*]})"; exit 2; }
     tests=() ;;
-  --help|-h) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  --help|-h) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   "") tests=("${quick[@]}") ;;
   *) tests=("$@") ;;
 esac
@@ -72,7 +72,7 @@ for t in "${fuzz_targets[@]}"; do
   regressions=("$DM_ROOT/test/fuzz/regressions/$t"/*)
   if [ -e "${regressions[0]}" ]; then
     say "fuzz: $t, its ${#regressions[@]} regression input(s)"
-    if ! "$bin" "${fuzz_flags[@]}" "${regressions[@]}" >"$log" 2>&1; then
+    if ! "$bin" "${fuzz_flags[@]}" -artifact_prefix="$fuzz/$t-" "${regressions[@]}" >"$log" 2>&1; then
       failed+=("fuzz_$t regressions"); tail -30 "$log"; continue
     fi
   fi

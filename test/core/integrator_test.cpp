@@ -111,12 +111,12 @@ TEST(Integrator, StableBelowAndUnstableAboveTwoOverOmega) {
 // pair's 2k/m. The guard sums the modes on the body (a bound on the assembled system's highest
 // frequency): its critical step is the pair's, 2/sqrt(2k/m), exact here; the stiffest element alone
 // would allow sqrt(2) times that, where the run diverges.
-double TwoSpringAmplitude(double step) {
+double TwoSpringAmplitude(double step, double c = 0.0) {
   MultibodySystem s;
   s.set_gravity(Vector3d::Zero());
   const int b = s.AddBody(test::MakeBody("mass", 2.0, Vector3d(1.0, 1.0, 1.0)));
-  s.point_joints.push_back(test::MakePoint(s, 0, b, Vector3d::Zero(), 800.0, 0.0));
-  s.point_joints.push_back(test::MakePoint(s, 0, b, Vector3d::Zero(), 800.0, 0.0));
+  s.point_joints.push_back(test::MakePoint(s, 0, b, Vector3d::Zero(), 800.0, c));
+  s.point_joints.push_back(test::MakePoint(s, 0, b, Vector3d::Zero(), 800.0, c));
   s.mutable_body(b).v = Vector3d(1.0, 0.0, 0.0);
   s.Finalize(step, /*check_step=*/false);
   double amax = 0.0;
@@ -142,6 +142,17 @@ TEST(Integrator, GuardSumsTheElementsOnABody) {
   EXPECT_LT(TwoSpringAmplitude(0.98 * pair), 6.0);
   EXPECT_GT(TwoSpringAmplitude(1.02 * pair), 1e6);
   EXPECT_GT(TwoSpringAmplitude(0.9 * single), 1e6);  // what the stiffest element alone would allow
+  // damped (each spring zeta 0.5 on its own mode): the dampers add up as the springs do, the pair's
+  // damping ratio is 2 x 0.5 x 20 / sqrt(800) = 0.707 and its step (2/omega)(sqrt(1+zeta^2)-zeta)
+  MultibodySystem d;
+  const int m = d.AddBody(test::MakeBody("mass", 2.0, Vector3d(1.0, 1.0, 1.0)));
+  d.point_joints.push_back(test::MakePoint(d, 0, m, Vector3d::Zero(), 800.0, 40.0));
+  d.point_joints.push_back(test::MakePoint(d, 0, m, Vector3d::Zero(), 800.0, 40.0));
+  const double omega = std::sqrt(1600.0 / 2.0), zeta = 2.0 * 0.5 * 20.0 / omega;
+  const double damped = 2.0 / omega * (std::sqrt(1.0 + zeta * zeta) - zeta);
+  EXPECT_NEAR(d.CriticalTimeStep().dt_crit, damped, 1e-12);
+  EXPECT_LT(TwoSpringAmplitude(0.98 * damped, 40.0), 6.0);
+  EXPECT_GT(TwoSpringAmplitude(1.05 * damped, 40.0), 1e6);
 }
 
 TEST(Integrator, GuardRefusesAStepAboveTheLimit) {

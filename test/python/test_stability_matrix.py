@@ -48,6 +48,11 @@ class Judge(unittest.TestCase):
                                                                           'neighbour by 0.5 of the diameter (limit 0.4)'})[0],
                          'refused during the run')
         self.assertEqual(matrix.judge(3, '', {'status': 'error', 'error': 'it broke'})[0], 'FAILED')
+        # below the critical step with the guard on, stopping for instability is the guard's failure
+        unstable = {'status': 'error', 'error': 'step 9: the vehicle\'s energy rose 5 J ...: the explicit integration is '
+                                                 'unstable at dt = 1e-4 s (the guard\'s critical step 2e-4 s, body b)'}
+        self.assertEqual(matrix.judge(3, '', unstable)[0], 'refused during the run')
+        self.assertEqual(matrix.judge(3, '', unstable, guarded=True)[0], 'FAILED')
         self.assertEqual(matrix.judge(-11, 'Segmentation fault', None)[0], 'FAILED')
 
 

@@ -63,6 +63,15 @@ std::string ResultFile::Text() const {
   return std::string(e.c_str()) + "\n";
 }
 
+ResultFile& ResultFile::SetLedger(const std::string& prefix, const LedgerWatch& w) {
+  Set(prefix + "_dissipated", w.dissipated);
+  Set(prefix + "_dissipated_least", w.least);
+  Set(prefix + "_dissipated_least_time", w.least_time);
+  Set(prefix + "_largest_fall", w.largest_fall);
+  Set(prefix + "_scale", w.Scale());
+  return Set(prefix + "_samples", w.samples);
+}
+
 void ResultFile::Write(const std::string& path) const {
   std::ofstream out(path);
   if (!out) throw ConfigError(path + ": cannot write the result file");

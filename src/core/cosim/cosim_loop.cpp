@@ -30,6 +30,17 @@ MobilitySample Sample(const VehicleCoSim& sim, double t, const Eigen::Vector3d& 
   return s;
 }
 
+/// The energy watchdog's message.
+std::string Unstable(const VehicleCoSim& sim, const LedgerWatch& w) {
+  const std::string what = w.finite() ? detail::Concat("the vehicle's energy rose ", -w.least,
+                                                       " J above what the terrain and the engine put in (more than ",
+                                                       kLedgerTolerance, " of the ", w.Scale(), " J through its ledger)")
+                                      : std::string("the vehicle's energy ledger is not finite");
+  return detail::Concat("step ", sim.step(), " (t = ", sim.driver_time(), " s): ", what,
+                        ": the explicit integration is unstable at dt = ", sim.dt(), " s (the guard's critical step ",
+                        sim.limit().dt_crit, " s, ", sim.limit().element, ")");
+}
+
 }  // namespace
 
 MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, DriverPort& driver, CoSimObserver* observer) {
@@ -49,6 +60,8 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
   const long run_steps = std::lround(p.duration / dt);
   const long sample_every = std::max(1L, std::lround(1.0 / (p.sample_rate * dt)));
   const long control_every = std::max(1L, std::lround(p.driver.control_period / dt));
+  // the watchdog's least scale: the vehicle's weight times its tire radius
+  r.vehicle_ledger.floor = veh.system().TotalMass() * 9.81 * veh.tire().radius;
   DriverCommand cmd;
   cmd.brake_effort = 1.0;  // settling: brakes on, no drive
   Eigen::Vector3d p0 = Eigen::Vector3d::Zero();  // the chassis frame at the driver's start
@@ -95,16 +108,10 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
         if (k >= run_steps) break;
       }
       if (sim.step() % sample_every == 0) {
-        LedgerWatch& w = r.vehicle_ledger;
-        w.Sample(veh.Energy(), sim.driver_time());
         // the energy watchdog: a vehicle whose energy rises past what the terrain and the engine
         // put in is unstable (its dampers cannot give energy): stop, naming the step and the guard
-        if (w.least < -kLedgerTolerance * w.Scale() - 1e-6 || !w.finite())
-          throw SimulationError(detail::Concat(
-              "step ", sim.step(), " (t = ", sim.driver_time(), " s): the vehicle's energy rose ", -w.least,
-              " J above what the terrain and the engine put in (more than ", kLedgerTolerance, " of the ", w.Scale(),
-              " J through its ledger): the explicit integration is unstable at dt = ", dt, " s (the guard's critical step ",
-              sim.limit().dt_crit, " s, ", sim.limit().element, ")"));
+        r.vehicle_ledger.Sample(veh.Energy(), sim.driver_time());
+        if (r.vehicle_ledger.Broken(kLedgerTolerance)) throw SimulationError(Unstable(sim, r.vehicle_ledger));
       }
       if (observer && observer->StopRequested()) {
         r.interrupted = true;
@@ -118,14 +125,10 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
   }
   r.vehicle_energy = veh.Energy();
   r.vehicle_ledger.Sample(r.vehicle_energy, sim.driver_time());
-  const LedgerWatch& w = r.vehicle_ledger;
-  if (!r.error.empty() && r.error.find("vehicle's energy rose") == std::string::npos &&
-      (w.least < -kLedgerTolerance * w.Scale() - 1e-6 || !w.finite()))
-    // a blow-up that something else caught first (a wheel thrown off the road): say what it was
-    r.error = detail::Concat("the vehicle's energy rose ", -w.least, " J above what the terrain and the engine put in (",
-                             "more than ", kLedgerTolerance, " of the ", w.Scale(), " J through its ledger): the explicit ",
-                             "integration is unstable at dt = ", dt, " s (the guard's critical step ", sim.limit().dt_crit,
-                             " s, ", sim.limit().element, "); it stopped at: ", r.error);
+  if (r.vehicle_ledger.Broken(kLedgerTolerance) && r.error.find("the explicit integration is unstable") == std::string::npos)
+    // a blow-up in the last samples, or one something else caught first (a wheel thrown off the
+    // road): say what it was
+    r.error = Unstable(sim, r.vehicle_ledger) + (r.error.empty() ? "" : "; it stopped at: " + r.error);
   r.steps = sim.step();
   r.exchanges = sim.exchanges();
   r.sim_time = r.history.empty() ? 0.0 : r.history.back().t;

@@ -219,12 +219,7 @@ ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParam
   f.Set("vehicle_energy_kinetic", e.kinetic);
   f.Set("vehicle_energy_terrain_work", e.wall_work);
   f.Set("vehicle_energy_engine_work", e.exchanged);
-  f.Set("vehicle_energy_dissipated", w.dissipated);
-  f.Set("vehicle_energy_dissipated_least", w.least);
-  f.Set("vehicle_energy_dissipated_least_time", w.least_time);
-  f.Set("vehicle_energy_largest_fall", w.largest_fall);
-  f.Set("vehicle_energy_scale", w.Scale());
-  f.Set("vehicle_energy_samples", w.samples);
+  f.SetLedger("vehicle_energy", w);
   if (!published.empty()) f.SetCounts("published", published);
   if (terrain) terrain->Describe(&f);
   return f;

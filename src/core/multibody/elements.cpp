@@ -31,12 +31,14 @@ double InverseInertiaAbout(const RigidBody& b, const Vector3d& a_world) {
 
 namespace {
 // Frequency and damping ratio of a penalty spring k, damper c on a mode with inverse mass inv_m.
-StiffnessInfo Mode(double k, double c, double inv_m, const std::string& detail) {
+StiffnessInfo Mode(double k, double c, double inv_m, const std::string& detail,
+                   std::vector<std::pair<int, double>> sides = {}) {
   StiffnessInfo s;
   if (inv_m <= 0.0 || k <= 0.0) return s;
   s.omega = std::sqrt(k * inv_m);
   s.zeta = c * s.omega / (2.0 * k);
   s.detail = detail;
+  s.sides = std::move(sides);
   return s;
 }
 std::string Lightest(const Bodies& bodies, int a, int b) {
@@ -67,9 +69,9 @@ double PointJoint::PotentialEnergy(const Bodies& bodies) const {
   return 0.5 * k * g * g;
 }
 StiffnessInfo PointJoint::Stiffness(const Bodies& bodies) const {
-  const double inv_m = InverseEffectiveMass(bodies[a], bodies[a].R * ra) +
-                       InverseEffectiveMass(bodies[b], bodies[b].R * rb);
-  return Mode(k, c, inv_m, detail::Concat("k = ", k, " N/m, c = ", c, " N s/m, ", Lightest(bodies, a, b)));
+  const double wa = InverseEffectiveMass(bodies[a], bodies[a].R * ra), wb = InverseEffectiveMass(bodies[b], bodies[b].R * rb);
+  return Mode(k, c, wa + wb, detail::Concat("k = ", k, " N/m, c = ", c, " N s/m, ", Lightest(bodies, a, b)),
+              {{a, wa}, {b, wb}});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -96,8 +98,8 @@ StiffnessInfo PerpendicularAxes::Stiffness(const Bodies& bodies) const {
   Vector3d axis = (bodies[b].R * ub).cross(bodies[a].R * ua);
   if (axis.norm() < 1e-9) axis = bodies[a].R * ua;
   axis.normalize();
-  const double inv_i = InverseInertiaAbout(bodies[a], axis) + InverseInertiaAbout(bodies[b], axis);
-  return Mode(k, c, inv_i, detail::Concat("k = ", k, " N m/rad, ", Lightest(bodies, a, b)));
+  const double wa = InverseInertiaAbout(bodies[a], axis), wb = InverseInertiaAbout(bodies[b], axis);
+  return Mode(k, c, wa + wb, detail::Concat("k = ", k, " N m/rad, ", Lightest(bodies, a, b)), {{a, wa}, {b, wb}});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -125,8 +127,8 @@ double OrientationLock::PotentialEnergy(const Bodies& bodies) const {
   return 0.5 * k * th * th;
 }
 StiffnessInfo OrientationLock::Stiffness(const Bodies& bodies) const {
-  const double inv_i = MinInverseInertia(bodies[a]) + MinInverseInertia(bodies[b]);
-  return Mode(k, c, inv_i, detail::Concat("k = ", k, " N m/rad, ", Lightest(bodies, a, b)));
+  const double wa = MinInverseInertia(bodies[a]), wb = MinInverseInertia(bodies[b]);
+  return Mode(k, c, wa + wb, detail::Concat("k = ", k, " N m/rad, ", Lightest(bodies, a, b)), {{a, wa}, {b, wb}});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -166,11 +168,10 @@ double LineConstraint::PotentialEnergy(const Bodies& bodies) const {
 }
 StiffnessInfo LineConstraint::Stiffness(const Bodies& bodies) const {
   const Vector3d pb = bodies[b].PointWorld(rb);
-  const double inv_m = InverseEffectiveMass(bodies[a], pb - bodies[a].x) +
-                       InverseEffectiveMass(bodies[b], pb - bodies[b].x);
+  const double wa = InverseEffectiveMass(bodies[a], pb - bodies[a].x), wb = InverseEffectiveMass(bodies[b], pb - bodies[b].x);
   const double kk = std::max(k, drive ? k_drive : 0.0);
   const double cc = kk == k ? c : c_drive;
-  return Mode(kk, cc, inv_m, detail::Concat("k = ", kk, " N/m, ", Lightest(bodies, a, b)));
+  return Mode(kk, cc, wa + wb, detail::Concat("k = ", kk, " N/m, ", Lightest(bodies, a, b)), {{a, wa}, {b, wb}});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -199,11 +200,13 @@ StiffnessInfo RotationalCoupling::Stiffness(const Bodies& bodies) const {
   Vector3d sum = Vector3d::Zero();
   std::string lightest;
   double min_i = std::numeric_limits<double>::infinity();
+  std::vector<std::pair<int, double>> sides;
   for (const Term& t : terms) {
     const RigidBody& B = bodies[t.body];
     const Vector3d a = B.R * t.axis;
     const double ii = InverseInertiaAbout(B, a);
     inv_i += t.coeff * t.coeff * ii;
+    sides.emplace_back(t.body, t.coeff * t.coeff * ii);
     sum += t.coeff * a;
     if (ii > 0 && 1.0 / ii < min_i) {
       min_i = 1.0 / ii;
@@ -211,9 +214,13 @@ StiffnessInfo RotationalCoupling::Stiffness(const Bodies& bodies) const {
     }
   }
   const double sn = sum.norm();
-  if (sn > 1e-12) inv_i += sn * sn * InverseInertiaAbout(bodies[housing], sum / sn);
-  return Mode(k, c, inv_i,
-              detail::Concat("k = ", k, " N m/rad, smallest inertia '", lightest, "' ", min_i, " kg m^2"));
+  if (sn > 1e-12) {
+    const double wh = sn * sn * InverseInertiaAbout(bodies[housing], sum / sn);
+    inv_i += wh;
+    sides.emplace_back(housing, wh);
+  }
+  return Mode(k, c, inv_i, detail::Concat("k = ", k, " N m/rad, smallest inertia '", lightest, "' ", min_i, " kg m^2"),
+              std::move(sides));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -257,8 +264,8 @@ double CvTwist::PotentialEnergy(const Bodies& bodies) const {
 }
 StiffnessInfo CvTwist::Stiffness(const Bodies& bodies) const {
   const Vector3d m = (bodies[a].R * ua + bodies[b].R * ub).normalized();
-  const double inv_i = InverseInertiaAbout(bodies[a], m) + InverseInertiaAbout(bodies[b], m);
-  return Mode(k, c, inv_i, detail::Concat("k = ", k, " N m/rad, ", Lightest(bodies, a, b)));
+  const double wa = InverseInertiaAbout(bodies[a], m), wb = InverseInertiaAbout(bodies[b], m);
+  return Mode(k, c, wa + wb, detail::Concat("k = ", k, " N m/rad, ", Lightest(bodies, a, b)), {{a, wa}, {b, wb}});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -300,15 +307,14 @@ double SpringDamper::PotentialEnergy(const Bodies& bodies) const {
   return e;
 }
 StiffnessInfo SpringDamper::Stiffness(const Bodies& bodies) const {
-  const double inv_m = InverseEffectiveMass(bodies[a], bodies[a].R * ra) +
-                       InverseEffectiveMass(bodies[b], bodies[b].R * rb);
+  const double wa = InverseEffectiveMass(bodies[a], bodies[a].R * ra), wb = InverseEffectiveMass(bodies[b], bodies[b].R * rb);
   double k = linear_k + (spring.empty() ? 0.0 : spring.MaxSlope());
   double c = linear_c + (damper.empty() ? 0.0 : damper.MaxSlope());
   if (max_length > 0.0) {
     k += stop_k;
     c += stop_c;
   }
-  return Mode(k, c, inv_m, detail::Concat("k = ", k, " N/m, ", Lightest(bodies, a, b)));
+  return Mode(k, c, wa + wb, detail::Concat("k = ", k, " N/m, ", Lightest(bodies, a, b)), {{a, wa}, {b, wb}});
 }
 
 // ---------------------------------------------------------------------------------------------

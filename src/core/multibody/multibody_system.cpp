@@ -55,23 +55,38 @@ int MultibodySystem::FindBody(const std::string& name) const {
 
 TimeStepLimit MultibodySystem::CriticalTimeStep(const std::vector<BodyMode>& extra) const {
   const size_t n = bodies_.size();
-  std::vector<double> w2(n, 0.0), zeta(n, 0.0), top(n, 0.0);
+  std::vector<double> w2(n, 0.0), zw(n, 0.0), top(n, 0.0);
   std::vector<int> count(n, 0);
   std::vector<std::string> stiffest(n);
-  const auto add = [&](int b, const std::string& name, const StiffnessInfo& s) {
-    if (b < 0 || b >= static_cast<int>(n) || bodies_[b].fixed || !(s.omega > 0.0)) return;
-    const double o2 = s.omega * s.omega;
+  // body b takes the share f of an element's mode (its omega^2 and its damping)
+  const auto take = [&](int b, const std::string& name, const StiffnessInfo& s, double f) {
+    if (b < 0 || b >= static_cast<int>(n) || bodies_[b].fixed || !(s.omega > 0.0) || !(f > 0.0)) return;
+    const double o2 = f * s.omega * s.omega;
     w2[b] += o2;
-    zeta[b] = std::max(zeta[b], s.zeta);
+    zw[b] += f * s.zeta * s.omega;  // the dampers add up as the springs do: 2 zeta_b omega_b = sum 2 zeta_e omega_e
     ++count[b];
     if (o2 > top[b]) {
       top[b] = o2;
       stiffest[b] = name + " (" + s.detail + ")";
     }
   };
+  // an element's mode, k |sum_t u_t|^2 with |u_t|^2 <= w_t |q_t|_M^2, is at most k sum_t w_t |q_t|^2 / a_t
+  // for any a_t > 0 summing to 1 (Cauchy-Schwarz); with a_t = sqrt(w_t) / sum sqrt(w), body t takes
+  // omega^2 sqrt(w_t) sum sqrt(w) / sum w: a light arm on the chassis nearly all of it, the chassis little
+  const auto add = [&](int b, const std::string& name, const StiffnessInfo& s) {
+    if (s.sides.empty()) return take(b, name, s, 1.0);
+    double root = 0.0, total = 0.0;
+    for (const auto& [body, w] : s.sides) {
+      root += std::sqrt(std::max(0.0, w));
+      total += std::max(0.0, w);
+    }
+    if (!(total > 0.0)) return;
+    for (const auto& [body, w] : s.sides)
+      if (body == b) take(b, name, s, std::sqrt(std::max(0.0, w)) * root / total);
+  };
   const auto pair = [&](const std::string& kind, const std::string& name, int a, int b, const StiffnessInfo& s) {
     add(a, kind + " '" + name + "'", s);
-    add(b, kind + " '" + name + "'", s);
+    if (b != a) add(b, kind + " '" + name + "'", s);
   };
   for (const auto& e : point_joints) pair("joint", e.name, e.a, e.b, e.Stiffness(bodies_));
   for (const auto& e : perpendicular_axes) pair("joint", e.name, e.a, e.b, e.Stiffness(bodies_));
@@ -79,8 +94,10 @@ TimeStepLimit MultibodySystem::CriticalTimeStep(const std::vector<BodyMode>& ext
   for (const auto& e : line_constraints) pair("joint", e.name, e.a, e.b, e.Stiffness(bodies_));
   for (const auto& e : couplings) {
     const StiffnessInfo s = e.Stiffness(bodies_);
-    add(e.housing, "coupling '" + e.name + "'", s);
-    for (const auto& t : e.terms) add(t.body, "coupling '" + e.name + "'", s);
+    std::vector<int> seen;  // each body once (its share is the sum of its sides')
+    for (const auto& [body, w] : s.sides)
+      if (std::find(seen.begin(), seen.end(), body) == seen.end()) seen.push_back(body);
+    for (int body : seen) add(body, "coupling '" + e.name + "'", s);
   }
   for (const auto& e : cv_twists) pair("joint", e.name, e.a, e.b, e.Stiffness(bodies_));
   for (const auto& e : springs) pair("spring", e.name, e.a, e.b, e.Stiffness(bodies_));
@@ -90,12 +107,12 @@ TimeStepLimit MultibodySystem::CriticalTimeStep(const std::vector<BodyMode>& ext
   lim.dt_crit = std::numeric_limits<double>::infinity();
   for (size_t b = 0; b < n; ++b) {
     if (count[b] == 0) continue;
-    const double omega = std::sqrt(w2[b]), dt = CriticalStep(omega, zeta[b]);
+    const double omega = std::sqrt(w2[b]), zeta = zw[b] / omega, dt = CriticalStep(omega, zeta);
     if (dt < lim.dt_crit) {
       lim.dt_crit = dt;
       lim.element = "body '" + bodies_[b].name + "'";
       lim.detail = detail::Concat(count[b], " elements on it together (omega at most ", omega,
-                                  " rad/s, damping ratio ", zeta[b], "), the stiffest ", stiffest[b]);
+                                  " rad/s, damping ratio ", zeta, "), the stiffest ", stiffest[b]);
     }
   }
   return lim;

@@ -307,12 +307,16 @@ DemSoilBin::DemSoilBin(const DemSoilBin& o)
       shift_(o.shift_),
       watch_(o.watch_),
       watch_every_(o.watch_every_),
-      watch_start_(o.watch_start_) {}
+      watch_start_(o.watch_start_),
+      watch_plastic_(o.watch_plastic_) {}
 
 void DemSoilBin::WatchEnergy(double period) {
   watch_ = LedgerWatch();
   watch_every_ = std::max(1L, std::lround(period / dem_->dt()));
   dem_->set_plastic_ledger(true);  // the law's own plastic exchange in the ledger: `dissipated` is the dampers' and friction's
+  watch_plastic_ = dem_->plastic_exchange();
+  // the least scale: the soil's weight times a particle diameter
+  watch_.floor = dem_->num_alive() * dem_->mass() * dem_->gravity().norm() * p_.level.particle_diameter;
   watch_start_ = dem_->Energy();
   watch_.Sample(watch_start_, dem_->time());
 }
@@ -325,12 +329,8 @@ void DemSoilBin::DescribeEnergy(ResultFile* r) const {
   const EnergyReport e = dem_->Energy();
   r->Set("soil_energy_wall_work", e.wall_work - watch_start_.wall_work);
   r->Set("soil_energy_exchanged", e.exchanged - watch_start_.exchanged);
-  r->Set("soil_energy_plastic", dem_->plastic_exchange());
-  r->Set("soil_energy_dissipated", watch_.dissipated);
-  r->Set("soil_energy_dissipated_least", watch_.least);
-  r->Set("soil_energy_largest_fall", watch_.largest_fall);
-  r->Set("soil_energy_scale", watch_.Scale());
-  r->Set("soil_energy_samples", watch_.samples);
+  r->Set("soil_energy_plastic", dem_->plastic_exchange() - watch_plastic_);
+  r->SetLedger("soil_energy", watch_);
 }
 
 void DemSoilBin::ShiftZ(double dz) {
@@ -468,6 +468,8 @@ TerrainDisplay DemSoilTerrain::Display() const {
 void DemSoilTerrain::SetGravity(const Vector3d& g) {
   DM_THROW_UNLESS(g.allFinite() && g.norm() > 0.0, "dem_soil terrain: gravity ", g.transpose(), " is not a direction");
   bin_->dem().set_gravity(g);
+  // the run's ledger from the grade on (turning gravity is not energy the run passes through)
+  bin_->WatchEnergy(0.05);
 }
 
 void DemSoilTerrain::Describe(ResultFile* r) const {

@@ -54,8 +54,13 @@ struct LedgerWatch {
     last_work_ = e.wall_work;
     last_exchanged_ = e.exchanged;
   }
+  /// The least scale falls are judged against [J] (a system's weight times a length of its own: a
+  /// settling system moves energy between gravity and its springs before anything passes through)
+  double floor = 0.0;
   /// The scale falls are judged against [J].
-  double Scale() const { return throughput + kinetic_max; }
+  double Scale() const { return std::max(floor, throughput + kinetic_max); }
+  /// Whether the ledger fell below zero by more than `tolerance` of Scale(), or is not finite.
+  bool Broken(double tolerance) const { return nan_ || least < -tolerance * Scale(); }
   bool finite() const { return !nan_; }
 
  private:

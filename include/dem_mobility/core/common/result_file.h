@@ -9,6 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "dem_mobility/core/common/energy.h"
 #include "dem_mobility/core/common/error.h"
 
 namespace dem_mobility::core {
@@ -36,6 +37,9 @@ class ResultFile {
   ResultFile& SetFlow(const std::string& key, const std::vector<double>& values);
   /// A map of counts (e.g. messages published by topic).
   ResultFile& SetCounts(const std::string& key, const std::vector<std::pair<std::string, long>>& counts);
+  /// A ledger followed along a run (LedgerWatch): PREFIX_dissipated, _dissipated_least,
+  /// _dissipated_least_time, _largest_fall, _scale, _samples.
+  ResultFile& SetLedger(const std::string& prefix, const LedgerWatch& w);
   /// A map of equally long columns, each on one line (a history: t, x, speed, ...).
   ResultFile& SetColumns(const std::string& key, const std::vector<std::pair<std::string, std::vector<double>>>& cols);
 

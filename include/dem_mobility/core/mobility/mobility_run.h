@@ -101,7 +101,7 @@ struct SteadyFigures {
   int samples = 0;
   std::array<double, kWheels> slip{}, sinkage{};
   double traction_coefficient = 0.0;   ///< terrain pull / (m g cos(grade) cos(side slope))
-  double motion_resistance = 0.0;      ///< (thrust - pull) / (m g cos(grade))
+  double motion_resistance = 0.0;      ///< (thrust - pull) / (m g cos(grade) cos(side slope))
   double drawbar_margin = 0.0;         ///< traction_coefficient - tan(grade)
 };
 

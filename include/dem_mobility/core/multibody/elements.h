@@ -21,6 +21,9 @@ struct StiffnessInfo {
   double omega = 0.0;     ///< undamped angular frequency of the element's mode [rad/s]
   double zeta = 0.0;      ///< damping ratio of that mode
   std::string detail;     ///< what limits it (stiffness, lightest body)
+  /// The bodies the mode moves and each one's inverse mass (or inertia) in it, omega^2 = k sum of
+  /// them: how the guard shares the mode among them (MultibodySystem::CriticalTimeStep).
+  std::vector<std::pair<int, double>> sides;
 };
 
 /// Largest inverse effective mass of body `b` for a force at world offset `r` from its COM

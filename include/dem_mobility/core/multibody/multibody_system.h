@@ -55,13 +55,15 @@ class MultibodySystem {
     std::string name;
     StiffnessInfo mode;
   };
-  /// The time-step guard. Each element's own mode has omega_e^2 = k (1/m_a + 1/m_b) (the inverse
+  /// The time-step guard. Each element's own mode has omega_e^2 = k (w_a + w_b) (w: the inverse
   /// masses of its bodies in its worst direction); the elements on one body act on it together, and
-  /// the system's highest frequency is at most the largest over the bodies of sqrt(sum of omega_e^2
-  /// of the elements on the body) (Cauchy-Schwarz on each element's energy: k |J_a q_a - J_b q_b|^2
-  /// <= omega_e^2 (|q_a|_M^2 + |q_b|_M^2)). So the critical step is the smallest over the bodies of
-  /// (2 / omega)(sqrt(1 + zeta^2) - zeta) at that omega, zeta the largest damping ratio among the
-  /// body's elements: a bound that holds for the assembled system, where the stiffest element alone
+  /// the system's highest frequency is at most the largest over the bodies of sqrt(sum of the
+  /// shares of omega_e^2 of the elements on the body), body a's share being
+  /// omega_e^2 sqrt(w_a) (sqrt(w_a) + sqrt(w_b)) / (w_a + w_b) (Cauchy-Schwarz on each element's
+  /// energy: k |u_a - u_b|^2 <= k (w_a |q_a|^2 / t + w_b |q_b|^2 / (1 - t)) for any t in (0, 1);
+  /// t = sqrt(w_a) / (sqrt(w_a) + sqrt(w_b))). So the critical step is the smallest over the bodies of
+  /// (2 / omega)(sqrt(1 + zeta^2) - zeta) at that omega, with the dampers added as the springs are
+  /// (zeta = sum zeta_e omega_e / omega): a bound that holds for the assembled system, where the stiffest element alone
   /// is not one (the vehicle blew up at 0.7 of that element's step: docs/stability.md). `extra`:
   /// modes on bodies from outside (a terrain's contact on the wheels).
   TimeStepLimit CriticalTimeStep(const std::vector<BodyMode>& extra = {}) const;

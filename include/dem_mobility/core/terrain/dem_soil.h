@@ -178,6 +178,7 @@ class DemSoilBin {
   LedgerWatch watch_;
   long watch_every_ = 0;
   EnergyReport watch_start_;
+  double watch_plastic_ = 0.0;
 };
 
 class SoilPatch;
