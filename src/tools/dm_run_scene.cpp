@@ -99,6 +99,9 @@ int main(int argc, char** argv) {
   } catch (const ConfigError& e) {
     std::cerr << "dm_run_scene: error: " << e.what() << "\n";
     return 1;
+  } catch (const SimulationError& e) {  // (a scene that keeps no result of a failed run: the pour, the compression)
+    std::cerr << "dm_run_scene: simulation error: " << e.what() << "\n";
+    return 3;
   }
   return 0;
 }

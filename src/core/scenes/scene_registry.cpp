@@ -39,6 +39,24 @@ class Ticker {
   std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
 
+/// The result of a mobility run that stopped before it began (interrupted or failed while the
+/// terrain prepared): the terrain it was, no samples; the history's header is written.
+ResultFile BeforeTheRun(const MobilityRunParams& p, const SceneRunOptions& o,
+                        std::chrono::steady_clock::time_point wall0, const std::string& status, const std::string& why) {
+  MobilityRunResult r;
+  r.interrupted = status == "interrupted";
+  if (!r.interrupted) r.error = why;
+  r.terrain = DescribeTerrain(p.terrain_file, p.terrain_overrides);
+  r.terrain_model = r.terrain.model;
+  r.cone_index = r.terrain.cone_index;
+  r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  std::printf("%s\n", why.c_str());
+  if (!o.history_file.empty()) WriteMobilityHistory(r, o.history_file);
+  ResultFile f = MobilityResultFile(r, p);
+  f.SetStatus(status, why);
+  return f;
+}
+
 ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) {
   const MobilityRunParams p = MobilityRunParams::Read(reader);
   const auto wall0 = std::chrono::steady_clock::now();
@@ -48,17 +66,11 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
   } catch (const Interrupted& e) {
     // stopped while the terrain prepared, before the run began: the result and the history (its
     // header) say so, the result with how far the preparation had come
-    MobilityRunResult r;
-    r.interrupted = true;
-    r.terrain = DescribeTerrain(p.terrain_file, p.terrain_overrides);
-    r.terrain_model = r.terrain.model;
-    r.cone_index = r.terrain.cone_index;
-    r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    std::printf("%s\n", e.what());
-    if (!o.history_file.empty()) WriteMobilityHistory(r, o.history_file);
-    ResultFile f = MobilityResultFile(r, p);
-    f.SetStatus("interrupted", e.what());
-    return f;
+    return BeforeTheRun(p, o, wall0, "interrupted", e.what());
+  } catch (const SimulationError& e) {
+    // a numerical failure in the terrain's preparation or the opening exchange (a watchdog): the
+    // result says so, as a failure during a run does
+    return BeforeTheRun(p, o, wall0, "error", e.what());
   }
   MobilityRun& run = *made;
   const TimeStepLimit& lim = run.sim().limit();
