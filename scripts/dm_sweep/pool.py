@@ -4,6 +4,7 @@ read from the result YAML it writes; resume keeps the cases whose result is alre
 import os
 import re
 import signal
+import threading
 import socket
 import subprocess
 import time
@@ -296,9 +297,15 @@ class Sweep:
 
     def run(self, t0=None):
         """Runs every case not done yet (not kept by resume), `jobs` at a time, and returns the
-        outcomes in case order. A failed run is reported and the others go on. Ctrl-C terminates the
-        running runs (their error says 'interrupted') and raises KeyboardInterrupt."""
+        outcomes in case order. A failed run is reported and the others go on. Ctrl-C (and SIGTERM,
+        as a batch system or `kill` sends it) terminates the running runs (their error says
+        'interrupted') and raises KeyboardInterrupt."""
         self.t0 = time.time() if t0 is None else t0
+        restore = None
+        if threading.current_thread() is threading.main_thread():
+            def terminated(signum, frame):
+                raise KeyboardInterrupt('SIGTERM')
+            restore = signal.signal(signal.SIGTERM, terminated)
         pending = [o for o in self.outcomes if not o.done]
         running = []
         finished = len(self.outcomes) - len(pending)
@@ -355,6 +362,8 @@ class Sweep:
         finally:
             self._progress.close()
             self._progress = None
+            if restore is not None:
+                signal.signal(signal.SIGTERM, restore)
         return self.outcomes
 
     # -- the outcome
