@@ -5,18 +5,6 @@
 
 namespace dem_mobility::core {
 
-double NormalEnergy(const SoilContactLaw& law, double d, double fmax) {
-  if (!(d > 0.0)) return 0.0;
-  const double d0 = law.d0, dp = law.dp;
-  double u = 0.0;
-  if (d > d0) u += 0.5 * law.k_n * (d - d0) * (d - d0);
-  if (law.cohesion && fmax > 0.0 && dp > 0.0) {
-    const double a = std::min(d, d0);
-    u -= a <= dp ? 0.5 * fmax * a * a / dp : 0.5 * fmax * dp + fmax * (a - dp) - 0.5 * fmax * (a - dp) * (a - dp) / (d0 - dp);
-  }
-  return u;
-}
-
 double PairEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists, int i, int k) {
   // the elastic energy stored in one contact: its normal branches (repulsion, and the adhesion
   // triangle's potential, zero out of contact) and its anchor spring

@@ -244,8 +244,13 @@ void DemSystem::PlasticExchange() {
         const int j = lists_.partners()[k];
         const bool cj = plastic_changed_[j] != 0;
         if (!ci && !cj) continue;
-        const double gap = D - (ps_.x[i] - ps_.x[j]).norm();
         const double pi0 = ci ? plastic_before_[i] : ps_.plastic[i], pj0 = cj ? plastic_before_[j] : ps_.plastic[j];
+        // out of reach before and after the change (no overlap either way): nothing moved, and
+        // no square root taken (the listed pairs out of contact: a third and more of them)
+        const double reach = D - std::min(ps_.plastic[i] + ps_.plastic[j], pi0 + pj0);
+        const double r2 = (ps_.x[i] - ps_.x[j]).squaredNorm();
+        if (!(reach > 0.0) || r2 >= reach * reach) continue;
+        const double gap = D - std::sqrt(r2);
         const double ai0 = ci ? adhesion_before_[i] : ps_.adhesion_max[i];
         const double aj0 = cj ? adhesion_before_[j] : ps_.adhesion_max[j];
         de += NormalEnergy(law_, gap - (ps_.plastic[i] + ps_.plastic[j]), std::min(ps_.adhesion_max[i], ps_.adhesion_max[j])) -

@@ -23,8 +23,18 @@ struct DemEnergyTerms {
 double PairEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists, int i, int k);
 /// The normal branches' energy (repulsion, the adhesion triangle) of a contact of overlap `d` (the
 /// plastic deformations taken off) and largest adhesion `fmax`: the part the law's plastic changes
-/// move.
-double NormalEnergy(const SoilContactLaw& law, double d, double fmax);
+/// move. Inline: the plastic ledger calls it twice for every listed pair of a changed particle.
+inline double NormalEnergy(const SoilContactLaw& law, double d, double fmax) {
+  if (!(d > 0.0)) return 0.0;
+  const double d0 = law.d0, dp = law.dp;
+  double u = 0.0;
+  if (d > d0) u += 0.5 * law.k_n * (d - d0) * (d - d0);
+  if (law.cohesion && fmax > 0.0 && dp > 0.0) {
+    const double a = d < d0 ? d : d0;
+    u -= a <= dp ? 0.5 * fmax * a * a / dp : 0.5 * fmax * dp + fmax * (a - dp) - 0.5 * fmax * (a - dp) * (a - dp) / (d0 - dp);
+  }
+  return u;
+}
 /// Kinetic, gravitational and elastic energy of all live particles.
 EnergyReport MechanicalEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists);
 /// Slot i's kinetic and gravitational energy and that of all its pairs (what it takes away when removed).
