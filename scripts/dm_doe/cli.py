@@ -346,7 +346,15 @@ def cmd_run(a):
     prov = {'nrmm_prior': NRMM_VEHICLE, 'costs': COSTS, 'calibration_table': os.path.relpath(limits[2], ROOT)}
     if a.elevation:
         prov['elevation'] = os.path.abspath(a.elevation)
-    doc = runner.make_plan(grid, a.level, a.runner, a.dem_threads, a.duration, not a.no_prune, cost_of, prov)
+    scenes = {}
+    for kind in ('soil', 'road'):
+        f = getattr(a, kind + '_scene')
+        if f:
+            try:
+                scenes[kind] = runner.check_scene_file(f, kind)
+            except runner.RunnerError as e:
+                raise UsageError(str(e))
+    doc = runner.make_plan(grid, a.level, a.runner, a.dem_threads, a.duration, not a.no_prune, cost_of, prov, scenes)
     path = os.path.join(a.out, runner.PLAN_FILE)
     if os.path.exists(path):
         old = runner.load_plan(a.out)
@@ -512,6 +520,11 @@ def parser():
     p.add_argument('--no-wait', action='store_true', help='slurm: submit and return (doe status follows it)')
     p.add_argument('--dem-threads', type=int, default=1, help='soil threads of each run (default 1; slurm: --cpus-per-task)')
     p.add_argument('--duration', type=float, help='longest driving time [s] (default: the scenes\' 40 s)')
+    p.add_argument('--soil-scene', help='a scene file of kind soil_slope for the soil cases, instead of '
+                   'config/scenes/soil_slope.yaml (e.g. soil only under the tracks, a shorter box, your vehicle); '
+                   'the DOE still sets grade, level, cone index, soil threads and duration')
+    p.add_argument('--road-scene', help='a scene file of kind road_slope for the CI 300 cases, instead of '
+                   'config/scenes/road_slope.yaml')
     p.add_argument('--no-prune', action='store_true', help='run every case (no implied cases)')
     p.add_argument('--resume', action='store_true', help='go on with the DOE in --out: finished cases are kept')
     p.add_argument('--retry-failed', action='store_true', help='with --resume: run the failed cases again')

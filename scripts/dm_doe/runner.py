@@ -52,9 +52,36 @@ def case_name(grade, ci):
 
 # -- the plan -------------------------------------------------------------------------------------
 
-def make_plan(grid, level, runner, dem_threads, duration, prune, cost_of, provenance=None):
+def scene_file(doc, kind):
+    """The scene file of a case of `kind` (soil or road): the plan's own (doe run --soil-scene,
+    --road-scene) or the shipped one."""
+    own = (doc.get('scenes') or {}).get(kind)
+    return own['file'] if own else os.path.join(ROOT, 'config', 'scenes', SCENES[kind][1])
+
+
+def check_scene_file(path, kind):
+    """{'file': absolute path, 'sha256': of its bytes} of a scene file given for the `kind` cases;
+    RunnerError unless it is a YAML scene of that kind (soil_slope or road_slope)."""
+    import hashlib
+    want = SCENES[kind][1][:-len('.yaml')]
+    try:
+        with open(path, 'rb') as fh:
+            data = fh.read()
+        doc = yaml.safe_load(data)
+    except OSError as e:
+        raise RunnerError('--%s-scene %s: %s' % (kind, path, e.strerror))
+    except yaml.YAMLError as e:
+        raise RunnerError('--%s-scene %s: not YAML (%s)' % (kind, path, str(e).splitlines()[0]))
+    if not isinstance(doc, dict) or doc.get('scene') != want:
+        raise RunnerError('--%s-scene %s: scene: %r, where the %s cases take a scene of kind %s' % (
+            kind, path, doc.get('scene') if isinstance(doc, dict) else None, kind, want))
+    return {'file': os.path.abspath(path), 'sha256': hashlib.sha256(data).hexdigest()}
+
+
+def make_plan(grid, level, runner, dem_threads, duration, prune, cost_of, provenance=None, scenes=None):
     """The plan document: the cases in the grid's run order (dm_doe.plan.Grid.order), each with its
-    estimated cost [s] from cost_of(grade, ci)."""
+    estimated cost [s] from cost_of(grade, ci); `scenes`: {kind: check_scene_file(...)} for the
+    kinds whose cases run a scene file of the user's instead of the shipped one."""
     cases = []
     for k, (i, j) in enumerate(grid.order()):
         g, c = grid.grades[i], grid.cone_indices[j]
@@ -62,7 +89,7 @@ def make_plan(grid, level, runner, dem_threads, duration, prune, cost_of, proven
                       'scene': 'road' if c >= plan.ROAD_CONE_INDEX else 'soil',
                       'estimated_cost': round(float(cost_of(g, c)), 1)})
     doc = {'grades': grid.grades, 'cone_indices': grid.cone_indices, 'level': level, 'runner': runner,
-           'dem_threads': dem_threads, 'duration': duration, 'prune': bool(prune),
+           'dem_threads': dem_threads, 'duration': duration, 'prune': bool(prune), 'scenes': dict(scenes or {}),
            'commit': git_commit(ROOT), 'created': utc_now()}
     doc.update(provenance or {})
     doc['cases'] = cases
@@ -71,8 +98,8 @@ def make_plan(grid, level, runner, dem_threads, duration, prune, cost_of, proven
 
 def same_design(a, b):
     """None if two plans ask for the same runs, else what differs."""
-    for k in ('grades', 'cone_indices', 'level', 'runner', 'dem_threads', 'duration', 'prune'):
-        if a.get(k) != b.get(k):
+    for k in ('grades', 'cone_indices', 'level', 'runner', 'dem_threads', 'duration', 'prune', 'scenes'):
+        if (a.get(k) or None) != (b.get(k) or None):
             return '%s: %r in the folder, %r asked' % (k, a.get(k), b.get(k))
     return None
 
@@ -237,19 +264,22 @@ def decide(case, doc, states):
 def case_command(doc, case, out, port, dm_run_scene=None):
     """The argv of a case's run: roslaunch of the scene's launch file (what a user runs) or the
     core runner dm_run_scene."""
-    launch, scene = SCENES[case['scene']]
+    launch = SCENES[case['scene']][0]
+    scene = scene_file(doc, case['scene'])
     result = os.path.abspath(result_path(out, case))
     g, c = case['grade_deg'], case['cone_index']
     if doc['runner'] == 'roslaunch':
         argv = ['roslaunch', '-p', str(port), 'dem_mobility', launch, 'grade:=%g' % g, 'rviz:=false', 'end_run:=true',
                 'bag:=' + result[:-len('.result.yaml')] + '.bag']
+        if (doc.get('scenes') or {}).get(case['scene']):
+            argv.append('scene:=' + scene)
         if doc.get('duration'):
             argv.append('duration:=%g' % doc['duration'])
         if case['scene'] == 'soil':
             argv += ['fidelity:=' + doc['level'], 'cone_index:=%g' % c, 'dem_threads:=%d' % doc['dem_threads']]
         return argv
     exe = dm_run_scene or os.environ.get('DM_RUN_SCENE') or os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene')
-    argv = [exe, os.path.join(ROOT, 'config', 'scenes', scene), 'grade_deg=%g' % g]
+    argv = [exe, scene, 'grade_deg=%g' % g]
     if doc.get('duration'):
         argv.append('duration=%g' % doc['duration'])
     if case['scene'] == 'soil':
@@ -426,7 +456,9 @@ def write_doe_table(out, doc, rows):
     n_sim = sum(1 for r in rows if r['state'] == 'simulated')
     n_imp = sum(1 for r in rows if r['state'] == 'implied')
     summary = {'model': 'physics', 'level': doc['level'], 'runner': doc['runner'], 'plan_commit': doc.get('commit'),
-               'run_commits': commits, 'calibration_tables': tables, 'made': utc_now(),
+               'run_commits': commits, 'calibration_tables': tables,
+               'scene_files': {k: scene_file(doc, k) for k in SCENES},
+               'duration': doc.get('duration'), 'made': utc_now(),
                'cases': len(rows), 'simulated': n_sim, 'implied': n_imp, 'runs_saved': n_imp,
                'failed': sum(1 for r in rows if r['state'] == 'failed'),
                'not_run': sum(1 for r in rows if r['state'] in ('pending', 'running', 'interrupted')),

@@ -87,6 +87,42 @@ class Decisions(unittest.TestCase):
 
 
 @unittest.skipUnless(os.access(DM_RUN_SCENE, os.X_OK), 'no dm_run_scene at %s (build the core first)' % DM_RUN_SCENE)
+class CaseCommands(unittest.TestCase):
+    """What a case runs: the launch file (or dm_run_scene) with the DOE's grade, level, CI, threads
+    and duration, and the user's scene file where the plan has one (--soil-scene)."""
+
+    def test_the_plans_scene_files_reach_both_runners(self):
+        grid = plan.Grid([0.0, 12.0], [50.0, 300.0])
+        road = os.path.join(ROOT, 'config', 'scenes', 'road_slope.yaml')
+        soil = os.path.join(ROOT, 'config', 'scenes', 'soil_slope.yaml')
+        own = runner.check_scene_file(soil, 'soil')
+        self.assertEqual(own['file'], soil)
+        self.assertEqual(len(own['sha256']), 64)
+        with self.assertRaises(runner.RunnerError) as e:
+            runner.check_scene_file(road, 'soil')
+        self.assertIn("scene: 'road_slope', where the soil cases take a scene of kind soil_slope", str(e.exception))
+        for r in ('roslaunch', 'core'):
+            plain = runner.make_plan(grid, 'tiny', r, 2, 5.0, True, lambda g, c: 1.0)
+            given = runner.make_plan(grid, 'tiny', r, 2, 5.0, True, lambda g, c: 1.0, scenes={'soil': own})
+            self.assertIsNone(runner.same_design(plain, plain))
+            self.assertIn('scenes', runner.same_design(plain, given))
+            by = {(c['grade_deg'], c['cone_index']): c for c in given['cases']}
+            s = runner.case_command(given, by[(12.0, 50.0)], '/tmp/doe', 11611, dm_run_scene='/x/dm_run_scene')
+            g = runner.case_command(given, by[(12.0, 300.0)], '/tmp/doe', 11611, dm_run_scene='/x/dm_run_scene')
+            if r == 'roslaunch':
+                self.assertEqual(s[:5], ['roslaunch', '-p', '11611', 'dem_mobility', 'soil_slope.launch'])
+                for arg in ('grade:=12', 'scene:=' + soil, 'duration:=5', 'fidelity:=tiny', 'cone_index:=50', 'dem_threads:=2'):
+                    self.assertIn(arg, s)
+                self.assertEqual(g[4], 'road_slope.launch')
+                self.assertFalse([a for a in g if a.startswith('scene:=')])  # the shipped road scene
+            else:
+                self.assertEqual(s[:3], ['/x/dm_run_scene', soil, 'grade_deg=12'])
+                for arg in ('duration=5', 'terrain_overrides.fidelity=tiny', 'terrain_overrides.cone_index=50',
+                            'terrain_overrides.threads=2'):
+                    self.assertIn(arg, s)
+                self.assertEqual(g[1], road)
+
+
 class RoadDoe(unittest.TestCase):
     """A 3 x 1 DOE on the rigid road (grades 0, 1, 2 deg, CI 300): the plan runs 0 and 2 deg first
     (the axis's ends); 2 deg reaches the 25 m/s command, which bounds 1 deg from below: implied."""
@@ -210,6 +246,14 @@ class RoadDoe(unittest.TestCase):
             rc, _, se = doe('run', '--out', os.path.join(self.tmp, 'bad'), '--dry-run', *args)
             self.assertEqual(rc, 2, args)
             self.assertIn(what, se)
+        # a scene file for the soil cases that is of another kind, or missing: refused naming it
+        road = os.path.join(ROOT, 'config', 'scenes', 'road_slope.yaml')
+        for args, what in ((['--soil-scene', road], '--soil-scene %s: scene: \'road_slope\'' % road),
+                           (['--road-scene', '/nonexistent.yaml'], '--road-scene /nonexistent.yaml')):
+            rc, _, se = doe('run', '--out', os.path.join(self.tmp, 'bad'), '--dry-run', '--grades', '0',
+                            '--cone-indices', '50,300', *args)
+            self.assertEqual(rc, 2, args)
+            self.assertIn(what, se)
         rc, _, se = doe('status', '--out', os.path.join(self.tmp, 'nothing_here'))
         self.assertEqual(rc, 2)
         self.assertIn('no DOE here', se)
@@ -222,38 +266,65 @@ def have_slurm():
 @unittest.skipUnless(os.access(DM_RUN_SCENE, os.X_OK), 'no dm_run_scene at %s (build the core first)' % DM_RUN_SCENE)
 @unittest.skipUnless(have_slurm(), 'no Slurm (scripts/lib.sh DM_SLURM_PACKAGES)')
 class SlurmDoe(unittest.TestCase):
-    """The same road DOE as a job array on a real single-node cluster (dm_doe.local_cluster: its own
-    munge key, slurm.conf and ports in a temporary directory): the table is the local pool's."""
+    """A 3 x 3 DOE at the tiny level (grades 0, 12, 24 deg x CI 50, 100 psi on the soil and 300, the
+    road) on the local pool and as a job array on a real single-node cluster (dm_doe.local_cluster:
+    its own munge key, slurm.conf and ports in a temporary directory): the two tables are the same,
+    bit for bit. The soil cases take a scene file of the test's own (--soil-scene: soil only under
+    the tracks, a 6 m box, 0.2 s of settling) and every case 0.3 s of driving (--duration), so that
+    a soil case costs some 20 s, most of it the soil's preparation; the speeds are those of the
+    first 0.3 s (status not_steady), which is what the comparison needs: the same runs on both."""
 
-    def test_job_array_gives_the_local_pools_table(self):
+    def test_a_tiny_soil_doe_as_a_job_array_gives_the_local_pools_table(self):
         tmp = tempfile.mkdtemp(prefix='dm_doe_slurm_')
         try:
-            grid = ['--grades', '0,1,2', '--cone-indices', '300', '--runner', 'core', '--progress', 'plain']
+            scene = os.path.join(tmp, 'tiny_strips.yaml')
+            with open(os.path.join(ROOT, 'config', 'scenes', 'soil_slope.yaml')) as fh:
+                doc = yaml.safe_load(fh)
+            doc['vehicle'] = os.path.join(ROOT, 'config', 'vehicles', 'hmmwv', 'vehicle.yaml')
+            doc['terrain'] = os.path.join(ROOT, 'config', 'terrains', 'soil_patch.yaml')
+            doc['terrain_overrides'] = {'fidelity': 'tiny', 'cone_index': 100, 'track_strip_width': 0.9,
+                                        'levels': {'tiny': {'length': 6.0}}, 'patch': {'check_window': [0.3, 0.7]}}
+            doc['settle_time'] = 0.2
+            with open(scene, 'w') as fh:
+                yaml.safe_dump(doc, fh)
+            grid = ['--grades', '0,12,24', '--cone-indices', '50,100,300', '--level', 'tiny', '--soil-scene', scene,
+                    '--duration', '0.3', '--runner', 'core', '--progress', 'plain', '--jobs', '2']
             local = os.path.join(tmp, 'local')
             rc, so, se = doe('run', '--out', local, *grid)
             self.assertEqual(rc, 0, so + se)
+            a = load(os.path.join(local, 'doe_table.yaml'))
+            self.assertEqual((a['cases'], a['simulated'], a['implied'], a['failed']), (9, 9, 0, 0))
+            self.assertEqual(a['scene_files']['soil'], scene)
+            rows = {(r['grade_deg'], r['cone_index']): r for r in a['cases_table']}
+            for (g, c), r in rows.items():
+                self.assertEqual(r['source'], 'simulated (%s, %s)' % (('road', 'rigid road') if c == 300 else ('soil', 'tiny')))
+                self.assertTrue(r['speed_made_good'] == r['speed_made_good'], (g, c))  # a number, not NaN
+            # the soil cases ran the given scene: the tracks' strips, the 6 m box, the grade and CI the DOE set
+            res = load(os.path.join(local, 'runs', 'g12_ci50.result.yaml'))
+            self.assertEqual((res['grade_deg'], res['patch_track_strip_width'], res['fidelity']), (12.0, 0.9, 'tiny'))
+            self.assertAlmostEqual(res['cone_index_psi'], 50.0)
             with LocalCluster() as c:
                 out = os.path.join(tmp, 'slurm')
-                # one task at a time: the array runs in the plan's order, as the pool with --jobs 1
-                rc, so, se = doe('run', '--out', out, '--backend', 'slurm', '--jobs', '1', *grid, env=c.env)
+                rc, so, se = doe('run', '--out', out, '--backend', 'slurm', *grid, env=c.env)
                 self.assertEqual(rc, 0, so + se)
                 self.assertIn('submitted job array', so)
-                self.assertIn('3 COMPLETED (from sacct -c (job completion log) and squeue)', so)
+                self.assertIn('9 COMPLETED (from sacct -c (job completion log) and squeue)', so)
                 jobs = load(os.path.join(out, 'slurm', 'jobs.yaml'))['jobs']
-                self.assertEqual((len(jobs), jobs[0]['tasks']), (1, '0-2'))
+                self.assertEqual((len(jobs), jobs[0]['tasks']), (1, '0-8'))
                 # every task wrote its output; the cases their results
-                for k in range(3):
+                for k in range(9):
                     self.assertTrue(os.path.exists(os.path.join(out, 'slurm', '%s_%d.out' % (jobs[0]['job'], k))))
                 rc, so, _ = doe('status', '--out', out, env=c.env)
-                self.assertIn('simulated 2, implied 1', so)
-                self.assertIn('slurm job %s: 3 COMPLETED' % jobs[0]['job'], so)
+                self.assertIn('simulated 9, implied 0', so)
+                self.assertIn('slurm job %s: 9 COMPLETED' % jobs[0]['job'], so)
                 # a case whose task dies without a result: failed, with the task's state
                 doc = runner.load_plan(out)
                 lost = slurm.record_lost_tasks(out, doc, [0], {0: 'CANCELLED'})
                 self.assertEqual(lost, [])  # case 0 has its result: nothing lost
-            a, b = load(os.path.join(local, 'doe_table.yaml')), load(os.path.join(out, 'doe_table.yaml'))
+            b = load(os.path.join(out, 'doe_table.yaml'))
             self.assertEqual(a['speed'], b['speed'])  # bit for bit: the runs are deterministic
             self.assertEqual([r['source'] for r in a['cases_table']], [r['source'] for r in b['cases_table']])
+            self.assertEqual([r['status'] for r in a['cases_table']], [r['status'] for r in b['cases_table']])
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
 
