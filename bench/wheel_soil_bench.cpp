@@ -35,8 +35,9 @@ double RigRate(const SingleWheelRig& rig0, int threads, int steps, double* conta
 }
 
 // the same soil without the tire: the rig's DEM copied, the tire lifted 10 m and stopped
-double BareRate(const SingleWheelRig& rig0, int threads, int steps) {
+double BareRate(const SingleWheelRig& rig0, int threads, int steps, bool plastic_ledger = true) {
   DemSystem s(rig0.dem());
+  if (!plastic_ledger) s.set_plastic_ledger(false);  // (the rig's run keeps it: the soil's energy ledger)
   DemWall& t = s.mutable_wall(rig0.bin().tire_wall(0));
   t.position.z() += 10.0;
   t.velocity.setZero();
@@ -80,6 +81,13 @@ int main(int argc, char** argv) {
     std::printf("wheel_soil rig_rate_%dthread%s %.3f Mparticle-steps/s\n", T, T > 1 ? "s" : "", 1e-6 * rig_rate[T]);
     std::printf("wheel_soil bare_soil_rate_%dthread%s %.3f Mparticle-steps/s\n", T, T > 1 ? "s" : "", 1e-6 * bare_rate[T]);
     std::printf("wheel_soil rate_ratio_%dthread%s %.3f ratio\n", T, T > 1 ? "s" : "", rig_rate[T] / bare_rate[T]);
+    // the soil's plastic ledger (a pass over the pairs of every particle whose plastic deformation
+    // changed, after every step; on in every run that follows its energy): its cost on the bare soil
+    const double unledgered = BareRate(rig, T, steps, false);
+    std::printf("wheel_soil bare_soil_rate_without_plastic_ledger_%dthread%s %.3f Mparticle-steps/s\n", T,
+                T > 1 ? "s" : "", 1e-6 * unledgered);
+    std::printf("wheel_soil plastic_ledger_share_%dthread%s %.3f ratio\n", T, T > 1 ? "s" : "",
+                1.0 - bare_rate[T] / unledgered);
     std::fflush(stdout);
   }
   std::printf("wheel_soil tire_contacts_mean %.1f count\n", contacts);
