@@ -160,7 +160,7 @@ void DemSystem::ComputeForces() {
     ps_.f[i] = ps_.live(i) ? weight : Vector3d::Zero();
     ps_.max_repulsion[i] = ps_.max_tension[i] = ps_.overlap[i] = 0.0;
   }
-  SweepPairs(law_, soil_.diameter, dt_, T, &ps_, &lists_, settings_.pair_kernel, plastic_ledger_ ? &pair_gap_ : nullptr);
+  SweepPairs(law_, soil_.diameter, dt_, T, &ps_, &lists_, settings_.pair_kernel);
   ledger_.wall_power = walls_.Compute(&ps_, dt_, T);
 }
 
@@ -234,6 +234,7 @@ void DemSystem::PlasticExchange() {
   // every listed pair with a changed end, its normal energy after less before; per slot in
   // parallel, summed in slot order (the same sum on any number of threads)
   const int n = ps_.slots();
+  const double D = soil_.diameter;
 #pragma omp parallel for schedule(static) num_threads(Threads())
   for (int i = 0; i < n; ++i) {
     double de = 0.0;
@@ -244,10 +245,12 @@ void DemSystem::PlasticExchange() {
         const bool cj = plastic_changed_[j] != 0;
         if (!ci && !cj) continue;
         const double pi0 = ci ? plastic_before_[i] : ps_.plastic[i], pj0 = cj ? plastic_before_[j] : ps_.plastic[j];
-        // D - distance, as the sweep at these positions computed it; out of reach before and
-        // after the change (no overlap either way): nothing moved
-        const double gap = pair_gap_[k];
-        if (!(gap > std::min(ps_.plastic[i] + ps_.plastic[j], pi0 + pj0))) continue;
+        // out of reach before and after the change (no overlap either way): nothing moved, and
+        // no square root taken (the listed pairs out of contact: a third and more of them)
+        const double reach = D - std::min(ps_.plastic[i] + ps_.plastic[j], pi0 + pj0);
+        const double r2 = (ps_.x[i] - ps_.x[j]).squaredNorm();
+        if (!(reach > 0.0) || r2 >= reach * reach) continue;
+        const double gap = D - std::sqrt(r2);
         const double ai0 = ci ? adhesion_before_[i] : ps_.adhesion_max[i];
         const double aj0 = cj ? adhesion_before_[j] : ps_.adhesion_max[j];
         de += NormalEnergy(law_, gap - (ps_.plastic[i] + ps_.plastic[j]), std::min(ps_.adhesion_max[i], ps_.adhesion_max[j])) -

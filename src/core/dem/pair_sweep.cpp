@@ -20,7 +20,7 @@ namespace {
 // the scalar reference: the soil law's per-pair functions, one contact after the other
 
 void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
-                 NeighbourList* lists, double* pair_gap) {
+                 NeighbourList* lists) {
   const double D = diameter, D2 = D * D;
   std::vector<Vector3d>& x = ps->x;
   std::vector<Vector3d>& v = ps->v;
@@ -44,7 +44,6 @@ void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int thre
       const int j = nbr[k];
       const Vector3d r = xi - x[j];
       const double r2 = r.squaredNorm();
-      if (pair_gap) pair_gap[k] = D - std::sqrt(r2);
       if (r2 >= D2) {  // in the skin, not touching
         if (touching[k]) {
           hist[k] = TangentialHistory();
@@ -117,7 +116,6 @@ struct SweepArrays {
   const int *nbr_begin, *nbr_end, *nbr;
   TangentialHistory* hist;
   unsigned char* touching;
-  double* pair_gap;  ///< per listed pair: D - distance (nullptr: not wanted)
 };
 
 // One block's lanes: inputs gathered, outputs of the law.
@@ -128,7 +126,6 @@ struct alignas(64) Block {
   double sx[kBlock], sy[kBlock], sz[kBlock];     // the anchor spring: in, and out
   double fx[kBlock], fy[kBlock], fz[kBlock];     // the contact force on i
   double rep[kBlock], ten[kBlock], ovl[kBlock];  // repulsion, tension (-adhesion), overlap
-  double gap[kBlock];                            // D - distance, in the skin too
   double contact[kBlock];                        // 1: in contact (d > 0)
 };
 
@@ -198,7 +195,6 @@ template <bool kCohesion>
     b->rep[l] = contact ? repulsion : 0.0;
     b->ten[l] = contact ? -adhesion : 0.0;
     b->ovl[l] = skin ? overlap : 0.0;
-    b->gap[l] = overlap;
     b->contact[l] = contact ? 1.0 : 0.0;
   }
 }
@@ -237,8 +233,6 @@ template <bool kCohesion>
       b->sx[l] = b->sy[l] = b->sz[l] = 0.0;
     }
     BlockLaw<kCohesion>(c, n, b);
-    if (a.pair_gap)
-      for (int l = 0; l < m; ++l) a.pair_gap[k0 + l] = b->gap[l];
     for (int l = 0; l < m; ++l) {  // no branch: a lane without contact adds zeros
       const int k = k0 + l, j = a.nbr[k];
       max_overlap = std::max(max_overlap, b->ovl[l]);
@@ -346,7 +340,7 @@ LawConstants ConstantsOf(const SoilContactLaw& law, double diameter, double dt) 
 }
 
 void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, double dt, int threads,
-                 ParticleStore* ps, NeighbourList* lists, double* pair_gap) {
+                 ParticleStore* ps, NeighbourList* lists) {
   const int n = ps->slots();
   if (static_cast<int>(ps->hot.size()) != n) ps->hot.resize(n);  // only when slots were appended
   HotParticle* hot = ps->hot.data();
@@ -374,8 +368,7 @@ void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, 
                       lists->list_end().data(),
                       lists->partners().data(),
                       lists->histories().data(),
-                      lists->touching().data(),
-                      pair_gap};
+                      lists->touching().data()};
   const SlotState* state = ps->state.data();
   const int ns = lists->num_slabs();
   for (int colour = 0; colour < 2; ++colour) {
@@ -415,17 +408,12 @@ const char* PairKernelName(PairKernel kernel) {
 }
 
 void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
-                NeighbourList* lists, PairKernel kernel, std::vector<double>* pair_gap) {
-  double* gap = nullptr;
-  if (pair_gap) {
-    if (pair_gap->size() < lists->partners().size()) pair_gap->resize(lists->partners().size());
-    gap = pair_gap->data();
-  }
+                NeighbourList* lists, PairKernel kernel) {
   switch (kernel == PairKernel::kAuto ? ResolvePairKernel(kernel) : kernel) {
-    case PairKernel::kVectorAvx512: return SweepVector(SweepSlabAvx512, law, diameter, dt, threads, ps, lists, gap);
-    case PairKernel::kVectorAvx2: return SweepVector(SweepSlabAvx2, law, diameter, dt, threads, ps, lists, gap);
-    case PairKernel::kVectorBaseline: return SweepVector(SweepSlabBaseline, law, diameter, dt, threads, ps, lists, gap);
-    default: return SweepScalar(law, diameter, dt, threads, ps, lists, gap);
+    case PairKernel::kVectorAvx512: return SweepVector(SweepSlabAvx512, law, diameter, dt, threads, ps, lists);
+    case PairKernel::kVectorAvx2: return SweepVector(SweepSlabAvx2, law, diameter, dt, threads, ps, lists);
+    case PairKernel::kVectorBaseline: return SweepVector(SweepSlabBaseline, law, diameter, dt, threads, ps, lists);
+    default: return SweepScalar(law, diameter, dt, threads, ps, lists);
   }
 }
 

@@ -182,7 +182,6 @@ class DemSystem {
   // the plastic pass's scratch (per slot: the deformation and adhesion before the step's change,
   // whether it changed, the energy change of its half list's pairs), grown with the slots
   std::vector<double> plastic_before_, adhesion_before_, plastic_de_;
-  std::vector<double> pair_gap_;  ///< per listed pair: D - distance at the last sweep (while the ledger is on)
   std::vector<char> plastic_changed_;
 };
 

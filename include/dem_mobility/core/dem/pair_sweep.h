@@ -36,11 +36,9 @@ const char* PairKernelName(PairKernel kernel);
 
 /// Adds the pair forces to ps->f (set beforehand to the weights) and records each particle's
 /// largest repulsion, tension and overlap (reset beforehand); updates the contact histories. The
-/// vector kernels first pack each slot's hot record (ps->hot). `pair_gap` (may be null): set, per
-/// listed pair k (lists->partners()[k]), to D - the pair's distance, as the law computed it (the
-/// plastic ledger's pass reads it: DemSystem::PlasticExchange); grown to the lists' size.
+/// vector kernels first pack each slot's hot record (ps->hot).
 void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
-                NeighbourList* lists, PairKernel kernel = PairKernel::kAuto, std::vector<double>* pair_gap = nullptr);
+                NeighbourList* lists, PairKernel kernel = PairKernel::kAuto);
 
 /// The benchmark's ceiling: pairs per second of the law alone on `kernel` (vector instances only),
 /// on one block of 16 pairs in contact that stays in L1 (no gather, no scatter, no memory), over
