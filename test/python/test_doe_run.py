@@ -269,9 +269,9 @@ class SlurmDoe(unittest.TestCase):
     """A 3 x 3 DOE at the tiny level (grades 0, 12, 24 deg x CI 50, 100 psi on the soil and 300, the
     road) on the local pool and as a job array on a real single-node cluster (dm_doe.local_cluster:
     its own munge key, slurm.conf and ports in a temporary directory): the two tables are the same,
-    bit for bit. The soil cases take a scene file of the test's own (--soil-scene: soil only under
-    the tracks, a 6 m box, 0.2 s of settling) and every case 0.3 s of driving (--duration), so that
-    a soil case costs some 20 s, most of it the soil's preparation; the speeds are those of the
+    bit for bit. The soil cases take a scene file of the test's own (--soil-scene: soil only in
+    0.6 m strips under the tracks, a 6 m box, 0.2 s of settling) and every case 0.3 s of driving
+    (--duration), so that a soil case costs some 15 s, most of it the soil's preparation; the speeds are those of the
     first 0.3 s (status not_steady), which is what the comparison needs: the same runs on both."""
 
     def test_a_tiny_soil_doe_as_a_job_array_gives_the_local_pools_table(self):
@@ -282,7 +282,7 @@ class SlurmDoe(unittest.TestCase):
                 doc = yaml.safe_load(fh)
             doc['vehicle'] = os.path.join(ROOT, 'config', 'vehicles', 'hmmwv', 'vehicle.yaml')
             doc['terrain'] = os.path.join(ROOT, 'config', 'terrains', 'soil_patch.yaml')
-            doc['terrain_overrides'] = {'fidelity': 'tiny', 'cone_index': 100, 'track_strip_width': 0.9,
+            doc['terrain_overrides'] = {'fidelity': 'tiny', 'cone_index': 100, 'track_strip_width': 0.6,
                                         'levels': {'tiny': {'length': 6.0}}, 'patch': {'check_window': [0.3, 0.7]}}
             doc['settle_time'] = 0.2
             with open(scene, 'w') as fh:
@@ -301,7 +301,7 @@ class SlurmDoe(unittest.TestCase):
                 self.assertTrue(r['speed_made_good'] == r['speed_made_good'], (g, c))  # a number, not NaN
             # the soil cases ran the given scene: the tracks' strips, the 6 m box, the grade and CI the DOE set
             res = load(os.path.join(local, 'runs', 'g12_ci50.result.yaml'))
-            self.assertEqual((res['grade_deg'], res['patch_track_strip_width'], res['fidelity']), (12.0, 0.9, 'tiny'))
+            self.assertEqual((res['grade_deg'], res['patch_track_strip_width'], res['fidelity']), (12.0, 0.6, 'tiny'))
             self.assertAlmostEqual(res['cone_index_psi'], 50.0)
             with LocalCluster() as c:
                 out = os.path.join(tmp, 'slurm')
