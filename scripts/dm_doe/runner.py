@@ -19,6 +19,7 @@ side (the local pool, or the tasks of a Slurm job array) see each other.
 import contextlib
 import datetime
 import fcntl
+import hashlib
 import os
 import signal
 import socket
@@ -52,17 +53,20 @@ def case_name(grade, ci):
 
 # -- the plan -------------------------------------------------------------------------------------
 
-def scene_file(doc, kind):
-    """The scene file of a case of `kind` (soil or road): the plan's own (doe run --soil-scene,
-    --road-scene) or the shipped one."""
+def own_scene(doc, kind):
+    """The plan's own scene file for the `kind` cases (doe run --soil-scene, --road-scene), or None."""
     own = (doc.get('scenes') or {}).get(kind)
-    return own['file'] if own else os.path.join(ROOT, 'config', 'scenes', SCENES[kind][1])
+    return own['file'] if own else None
+
+
+def scene_file(doc, kind):
+    """The scene file of a case of `kind` (soil or road): the plan's own or the shipped one."""
+    return own_scene(doc, kind) or os.path.join(ROOT, 'config', 'scenes', SCENES[kind][1])
 
 
 def check_scene_file(path, kind):
     """{'file': absolute path, 'sha256': of its bytes} of a scene file given for the `kind` cases;
     RunnerError unless it is a YAML scene of that kind (soil_slope or road_slope)."""
-    import hashlib
     want = SCENES[kind][1][:-len('.yaml')]
     try:
         with open(path, 'rb') as fh:
@@ -271,7 +275,7 @@ def case_command(doc, case, out, port, dm_run_scene=None):
     if doc['runner'] == 'roslaunch':
         argv = ['roslaunch', '-p', str(port), 'dem_mobility', launch, 'grade:=%g' % g, 'rviz:=false', 'end_run:=true',
                 'bag:=' + result[:-len('.result.yaml')] + '.bag']
-        if (doc.get('scenes') or {}).get(case['scene']):
+        if own_scene(doc, case['scene']):
             argv.append('scene:=' + scene)
         if doc.get('duration'):
             argv.append('duration:=%g' % doc['duration'])

@@ -291,8 +291,8 @@ TEST(DemShapes, ContainerFacetsAndConeMatchTheirGeometry) {
 // tiny particles (0.1 m, config/calibration/, from the sweep at the table's own level, tiny_cal)
 // predicts for its f; in both runs the PID holds the cone at its 0.1 m/s past the approach, the
 // lid held the consolidation pressure, and the soil compacted under it. (The table of the 0.06 m
-// particles, coarse_cal, was the one checked here until 2026-12-02: its two runs took 4-5 min of
-// both cores, a tenth of the suite; the tiny table's 1.5 min.)
+// particles, coarse_cal, was the one checked here until 2026-12-02: its two runs took 263 s each,
+// side by side, a third of the core suite's CPU time; the tiny table's take 85 s on two threads.)
 TEST(ConePenetrometer, ConeIndexRisesWithFWithinTheCalibrationBand) {
   const CiCalibration cal = CiCalibration::LoadFor(DM_CONFIG_DIR "/calibration", 0.1, 0.1);
   const ConeParams level = Cone({"fidelity=" + cal.level});

@@ -246,7 +246,7 @@ void DemSystem::PlasticExchange() {
         if (!ci && !cj) continue;
         const double pi0 = ci ? plastic_before_[i] : ps_.plastic[i], pj0 = cj ? plastic_before_[j] : ps_.plastic[j];
         // out of reach before and after the change (no overlap either way): nothing moved, and
-        // no square root taken (the listed pairs out of contact: a third and more of them)
+        // no square root taken
         const double reach = D - std::min(ps_.plastic[i] + ps_.plastic[j], pi0 + pj0);
         const double r2 = (ps_.x[i] - ps_.x[j]).squaredNorm();
         if (!(reach > 0.0) || r2 >= reach * reach) continue;

@@ -185,10 +185,7 @@ ResultFile MobilityResultFile(const MobilityRunResult& r, const MobilityRunParam
   if (!p.time_step_guard) f.Set("time_step_guard", false);
   f.Set("terrain", p.terrain_file);
   f.Set("terrain_model", r.terrain_model);
-  if (std::isfinite(r.cone_index))
-    f.Set("cone_index_psi", r.cone_index);
-  else
-    f.Set("cone_index_psi", YAML::Node());  // (a soil given by f with no table at its particle size: unknown)
+  f.SetMeasured("cone_index_psi", r.cone_index);  // (null: a soil given by f with no table at its particle size)
   if (!r.terrain.fidelity.empty()) f.Set("fidelity", r.terrain.fidelity);
   f.Set("speed_made_good", r.smg.value);
   f.Set("speed_made_good_mph", r.smg.value / 0.44704);

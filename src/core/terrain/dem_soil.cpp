@@ -504,22 +504,16 @@ void DemSoilTerrain::Describe(ResultFile* r) const {
   r->Set("patch_template_copies", s.copies);
   r->Set("patch_skipped_sites", s.skipped_sites);
   // (a figure not measured yet, such as the checks of a run too short for the patch to lay soil
-  // ahead, is null: never NaN in a result)
-  const auto measured = [&](const char* key, double v) {
-    if (std::isfinite(v))
-      r->Set(key, v);
-    else
-      r->Set(key, YAML::Node());
-  };
-  measured("patch_face_setback", s.face_setback);
+  // ahead, is null)
+  r->SetMeasured("patch_face_setback", s.face_setback);
   r->Set("patch_initial_density", s.initial.density);
   r->Set("patch_initial_surface", s.initial.surface);
   r->Set("patch_checks", s.checks);
-  measured("patch_density_ratio", s.density_ratio_mean);
-  measured("patch_density_ratio_min", s.density_ratio_min);
-  measured("patch_density_ratio_max", s.density_ratio_max);
-  measured("patch_surface_offset", s.surface_offset_mean);
-  measured("patch_surface_offset_max", s.surface_offset_max);
+  r->SetMeasured("patch_density_ratio", s.density_ratio_mean);
+  r->SetMeasured("patch_density_ratio_min", s.density_ratio_min);
+  r->SetMeasured("patch_density_ratio_max", s.density_ratio_max);
+  r->SetMeasured("patch_surface_offset", s.surface_offset_mean);
+  r->SetMeasured("patch_surface_offset_max", s.surface_offset_max);
   r->Set("patch_bed_slide_speed_max", s.bed_slide_speed_max);
 }
 

@@ -3,6 +3,7 @@
 // Doubles are written with 17 significant digits (they read back exactly).
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -32,6 +33,12 @@ class ResultFile {
     DM_DEMAND(!Reserved(key));
     body_[key] = value;
     return *this;
+  }
+  /// A figure that may not have been measured: written as null when not finite (a result never
+  /// holds NaN).
+  ResultFile& SetMeasured(const std::string& key, double value) {
+    if (std::isfinite(value)) return Set(key, value);
+    return Set(key, YAML::Node());
   }
   /// A list written on one line ([a, b, c]).
   ResultFile& SetFlow(const std::string& key, const std::vector<double>& values);
