@@ -1,7 +1,8 @@
 // dem_mobility/BagRecorderNodelet: writes a run's topics to one bag from inside the nodelet
 // manager. In the same process nothing is dropped (unbounded subscriber queues, no network), and
 // the bag is written in simulation-time order (each message's header stamp is its record time;
-// ties go by the order of ~topics), so the same run gives the same bag. When the end topic (the
+// ties go by the order of ~topics), so the same run gives the same bag; a latched topic's message
+// delivered twice (a race in roscpp) is recorded once. When the end topic (the
 // mobility result) arrives, everything is flushed, the bag is closed and, if asked, the run ends.
 // A bag that cannot be written (a full disk, a file size limit) is an error said at once: on the
 // latched topic recorder/error (std_msgs/String; the vehicle and the rigs stop their run with it)
@@ -86,6 +87,7 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     ros::Time latest;     ///< newest stamp received
     bool seen = false;
     long count = 0;
+    std::vector<uint8_t> last_latched;  ///< a latched topic's last message, serialized
     std::deque<Pending> queue;
     ros::Subscriber sub;
   };
@@ -151,10 +153,20 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     const auto& msg = event.getConstMessage();
     if (t.stamp_offset == -2) t.stamp_offset = StampOffset(msg->getMessageDefinition());
     ros::Time stamp = last_written_;
-    if (t.stamp_offset >= 0 && msg->size() >= static_cast<uint32_t>(t.stamp_offset) + 8) {
-      std::vector<uint8_t> buf(msg->size());
+    std::vector<uint8_t> buf;
+    if (t.latched || t.stamp_offset >= 0) {
+      buf.resize(msg->size());
       ros::serialization::OStream out(buf.data(), buf.size());
       msg->write(out);
+    }
+    if (t.latched) {
+      // roscpp can hand a latched message to a subscriber twice when the subscriber connects while
+      // it is being published (Publication::addSubscriberLink sends the latched copy after it has
+      // let go of the lock the publish takes): the same bytes again are that copy, not a new state
+      if (t.count > 0 && buf == t.last_latched) return;
+      t.last_latched = buf;
+    }
+    if (t.stamp_offset >= 0 && msg->size() >= static_cast<uint32_t>(t.stamp_offset) + 8) {
       const bool array = t.stamp_offset == 8;
       uint32_t n = 1, sec, nsec;
       if (array) std::memcpy(&n, buf.data(), 4);

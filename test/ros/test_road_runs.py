@@ -10,6 +10,7 @@ and key.
 
     python3 test/ros/test_road_runs.py   (after the catkin build; needs the workspace sourced)
 """
+import collections
 import os
 import shutil
 import signal
@@ -65,6 +66,8 @@ class RoadRuns(unittest.TestCase):
     def test_same_scene_twice_gives_identical_messages(self):
         ma, mb = self.a.messages(), self.b.messages()
         self.assertGreater(len(ma), 1000)
+        # per topic first, so that a difference names the topic
+        self.assertEqual(collections.Counter(t for t, _, _ in ma), collections.Counter(t for t, _, _ in mb))
         self.assertEqual(len(ma), len(mb))
         for (ta, da, sa), (tb, db, sb) in zip(ma, mb):
             if ta.endswith('result'):
