@@ -3,7 +3,8 @@
 #  1. the core GoogleTest suite with plain CMake (no ROS master), in the background beside 2-4,
 #  2. the catkin build of the whole package, then its catkin tests: roslaunch-check on every launch
 #     file and the rostest of the lock-step exchange (test/ros/road_scene.test),
-#  3. the end-to-end road runs through roslaunch (test/ros/test_road_runs.py), the cone index
+#  3. the bag recorder on its own (test/ros/test_bag_recorder.py), the end-to-end road runs
+#     through roslaunch (test/ros/test_road_runs.py), the cone index
 #     calibration sweep on tiny cases (test/ros/test_cone_sweep.py), the single-wheel rig
 #     (test/ros/test_single_wheel.py), the vehicle on the DEM soil patch (test/ros/test_soil_slope.py) and
 #     the speed-made-good map published as an OccupancyGrid (test/ros/test_map_publisher.py),
@@ -35,6 +36,8 @@ if ! catkin_test_results --verbose "$DM_WS/build/test_results/dem_mobility"; the
 fi
 say "test: the sweep package, the sweeps and the wheel references (python unit tests, no ROS; one tiny wheel run through the core)"
 (cd "$DM_ROOT" && DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 -m unittest discover -s test/python -v)
+say "test: the bag recorder on its own (a latched message delivered twice is recorded once)"
+python3 "$DM_ROOT/test/ros/test_bag_recorder.py"
 say "test: end-to-end road runs through roslaunch"
 DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 "$DM_ROOT/test/ros/test_road_runs.py"
 say "test: the cone index calibration sweep on tiny cases (roslaunch, bags, table, plots)"

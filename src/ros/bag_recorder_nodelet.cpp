@@ -87,7 +87,8 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     ros::Time latest;     ///< newest stamp received
     bool seen = false;
     long count = 0;
-    std::vector<uint8_t> last_latched;  ///< a latched topic's last message, serialized
+    bool seen_latched = false;          ///< a message from a latching publisher was received
+    std::vector<uint8_t> last_latched;  ///< the last one, serialized
     std::deque<Pending> queue;
     ros::Subscriber sub;
   };
@@ -130,8 +131,11 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     if (!end.empty() && end_index_ < 0)
       return Fatal("parameter " + pnh.resolveName("end_topic") + ": '" + end + "' is not in ~topics");
     // unbounded queues (0): in this process nothing is dropped
+    // the callback takes the message event, so that it has the connection header (who published,
+    // whether the publisher latches): bound to a plain message pointer it would not
+    using Event = const ros::MessageEvent<topic_tools::ShapeShifter const>&;
     for (size_t i = 0; i < topics_.size(); ++i) {
-      topics_[i].sub = nh.subscribe<topic_tools::ShapeShifter>(
+      topics_[i].sub = nh.subscribe<topic_tools::ShapeShifter, Event>(
           topics_[i].name, 0, boost::bind(&BagRecorderNodelet::OnMessage, this, i, boost::placeholders::_1));
     }
     NODELET_INFO("recording %zu topics to %s", topics_.size(), path_.c_str());
@@ -153,17 +157,24 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     const auto& msg = event.getConstMessage();
     if (t.stamp_offset == -2) t.stamp_offset = StampOffset(msg->getMessageDefinition());
     ros::Time stamp = last_written_;
+    // whether the publisher latches, from the connection header roscpp builds for it
+    bool latched_publisher = false;
+    if (const auto connection = event.getConnectionHeaderPtr()) {
+      const auto latching = connection->find("latching");
+      latched_publisher = latching != connection->end() && latching->second == "1";
+    }
     std::vector<uint8_t> buf;
-    if (t.latched || t.stamp_offset >= 0) {
+    if (latched_publisher || t.stamp_offset >= 0) {
       buf.resize(msg->size());
       ros::serialization::OStream out(buf.data(), buf.size());
       msg->write(out);
     }
-    if (t.latched) {
+    if (latched_publisher) {
       // roscpp can hand a latched message to a subscriber twice when the subscriber connects while
       // it is being published (Publication::addSubscriberLink sends the latched copy after it has
       // let go of the lock the publish takes): the same bytes again are that copy, not a new state
-      if (t.count > 0 && buf == t.last_latched) return;
+      if (t.seen_latched && buf == t.last_latched) return;
+      t.seen_latched = true;
       t.last_latched = buf;
     }
     if (t.stamp_offset >= 0 && msg->size() >= static_cast<uint32_t>(t.stamp_offset) + 8) {
