@@ -309,6 +309,23 @@ def port_from_env(default=11611):
         return default
 
 
+def wait_pid(pid, timeout):
+    """Waits up to `timeout` s for child `pid` to end: its exit status (-N: killed by signal N),
+    or None if it has not ended. (From a signal handler that interrupted a Popen.wait: that wait
+    holds the Popen's lock, so Popen.wait(timeout) would only time out.)"""
+    deadline = time.time() + timeout
+    while True:
+        try:
+            done, status = os.waitpid(pid, os.WNOHANG)
+        except ChildProcessError:
+            return None
+        if done:
+            return os.waitstatus_to_exitcode(status)
+        if time.time() >= deadline:
+            return None
+        time.sleep(0.02)
+
+
 def run_case(out, index, port=None, dm_run_scene=None, stream=None):
     """`doe case`: the case's turn. Exit status 0 if it is done (simulated now or before, or
     implied), 1 if its run failed."""
@@ -353,12 +370,25 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
     def stopped(signum, frame):
         # SIGTERM (the pool's timeout or Ctrl-C, Slurm's time limit or scancel): the run stops, the
         # case is recorded interrupted (resume runs it again; a timeout is made a failure by
-        # whoever set it), the marker goes
+        # whoever set it), the marker goes. A run that had written its good result already (the
+        # signal came while it was ending: roslaunch takes down its nodes after the result) keeps
+        # it: a finished case is never replaced
+        own_exit = wait_pid(child[0].pid, 0) if child else None  # None: the run had not ended by itself
         for c in child:
             with contextlib.suppress(OSError):
                 c.terminate()
-            with contextlib.suppress(Exception):
-                c.wait(20)
+            wait_pid(c.pid, 20)
+        if own_exit in (None, 0) and verdict(case, read_result(result_path(out, case))) is None:
+            write_yaml(provenance_path(out, case), {
+                'commit': git_commit(ROOT), 'host': socket.gethostname(), 'slurm_job': os.environ.get('SLURM_JOB_ID'),
+                'argv': argv, 'wall_time': round(time.time() - t0, 1), 'exit_status': 0,
+                'signal_after_result': signum})
+            with contextlib.suppress(OSError):
+                os.remove(marker_path(out, case))
+            print('%s: stopped by signal %d after its result was written: the result kept' % (case['name'], signum),
+                  file=stream)
+            stream.flush()
+            os._exit(0)
         write_yaml(result_path(out, case), {
             'kind': 'doe_case', 'status': 'interrupted', 'grade_deg': case['grade_deg'],
             'cone_index_psi': case['cone_index'], 'error': 'the case was stopped (signal %d) after %.0f s; see %s'

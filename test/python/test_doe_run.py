@@ -123,6 +123,71 @@ class CaseCommands(unittest.TestCase):
                 self.assertEqual(g[1], road)
 
 
+# a stand-in for dm_run_scene that ends as roslaunch does: `before` s, then a good road result
+# written to --out, a file beside it saying so, and `after` s more (roslaunch taking its nodes down)
+STAND_IN = r'''
+import sys, time
+before, after = float(sys.argv[1]), float(sys.argv[2])
+out = sys.argv[sys.argv.index('--out') + 1]
+time.sleep(before)
+with open(out, 'w') as fh:
+    fh.write('kind: road_slope\nstatus: command_limited\nerror: ""\ngrade_deg: 0\nspeed_made_good: 25.0\n')
+open(out + '.written', 'w').close()
+time.sleep(after)
+'''
+
+
+class CaseSignals(unittest.TestCase):
+    """`doe case` stopped by SIGTERM (a pool's timeout, Slurm's scancel): a run that had written its
+    good result and was still ending keeps it (a finished case is never replaced); a run stopped
+    before its result is recorded interrupted."""
+
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix='dm_doe_signal_')
+        self.out = os.path.join(self.tmp, 'doe')
+        os.makedirs(runner.runs_dir(self.out))
+        self.doc = runner.make_plan(plan.Grid([0.0], [300.0]), 'tiny', 'core', 1, 5.0, True, lambda g, c: 1.0)
+        runner.write_yaml(os.path.join(self.out, runner.PLAN_FILE), self.doc)
+        self.exe = os.path.join(self.tmp, 'stand_in')
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def case_stopped(self, before, after, wait_for_result):
+        with open(self.exe, 'w') as fh:
+            fh.write('#!/bin/sh\nexec %s -c "$STAND_IN_CODE" %g %g "$@"\n' % (sys.executable, before, after))
+        os.chmod(self.exe, 0o755)
+        env = dict(os.environ, DM_RUN_SCENE=self.exe, STAND_IN_CODE=STAND_IN)
+        p = subprocess.Popen([sys.executable, DOE, 'case', '--out', self.out, '--index', '0'], env=env,
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        case = self.doc['cases'][0]
+        written = runner.result_path(self.out, case) + '.written'
+        deadline = time.time() + 30
+        while not os.path.exists(written if wait_for_result else runner.marker_path(self.out, case)):
+            self.assertLess(time.time(), deadline, 'the case did not start')
+            time.sleep(0.05)
+        time.sleep(0.3)  # (the stand-in started: its sleep)
+        p.terminate()
+        so, _ = p.communicate(timeout=60)
+        return p.returncode, so, runner.scan(self.out, self.doc)[0], runner.read_result(runner.result_path(self.out, case))
+
+    def test_a_result_written_before_the_signal_is_kept(self):
+        rc, so, (state, _), r = self.case_stopped(0.0, 30.0, True)
+        self.assertEqual(rc, 0, so)
+        self.assertIn('the result kept', so)
+        self.assertEqual(state, 'simulated')
+        self.assertEqual((r['status'], r['speed_made_good']), ('command_limited', 25.0))
+        prov = runner.read_result(runner.provenance_path(self.out, self.doc['cases'][0]))
+        self.assertEqual((prov['exit_status'], prov['signal_after_result']), (0, 15))
+
+    def test_a_run_stopped_before_its_result_is_interrupted(self):
+        rc, so, (state, _), r = self.case_stopped(30.0, 0.0, False)
+        self.assertEqual(rc, 128 + 15, so)
+        self.assertEqual(state, 'interrupted')
+        self.assertEqual(r['status'], 'interrupted')
+        self.assertIn('stopped (signal 15)', r['error'])
+
+
 class RoadDoe(unittest.TestCase):
     """A 3 x 1 DOE on the rigid road (grades 0, 1, 2 deg, CI 300): the plan runs 0 and 2 deg first
     (the axis's ends); 2 deg reaches the 25 m/s command, which bounds 1 deg from below: implied."""
