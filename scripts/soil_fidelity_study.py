@@ -115,14 +115,17 @@ def summarize(sweep, cases_gs):
 def level_summary(rows, tolerance=1.0):
     """Per level: its largest |error| against the finest level over the cases where a finer level
     ran (its error estimate), and the default level by the issue's rule: the cheapest level whose
-    speed-made-good is within `tolerance` m/s of the finest in every case. Only a level that ran
-    every case is a candidate, and the finest level that did is the reference; the choice is
-    'provisional' while the reference is the only level that ran some case."""
+    speed-made-good is within `tolerance` m/s of the finest level run in every case. Only a level
+    that ran every case is a candidate; each case's own finest run is its reference (a finer level
+    that ran one case only still rules out a candidate that is off in that case). The choice is
+    'provisional' while the chosen level is itself the finest run in some case (nothing finer to
+    compare it with there)."""
     cases = sorted({(r['grade'], r['cone_index']) for r in rows})
     ran = {}
     for r in rows:
         ran.setdefault(r['level'], {})[(r['grade'], r['cone_index'])] = r
     complete = [l for l in LEVEL_ORDER if l in ran and all(c in ran[l] for c in cases)]
+    finest = {c: next(l for l in LEVEL_ORDER if l in ran and c in ran[l]) for c in cases}
     levels = {}
     for level in LEVEL_ORDER:
         if level not in ran:
@@ -136,21 +139,24 @@ def level_summary(rows, tolerance=1.0):
             'wall_time': sum(x['wall_time'] for x in ran[level].values()),
         }
     out = {'tolerance': tolerance, 'cases': [list(c) for c in cases], 'levels': levels, 'default_level': None,
-           'rule': 'the cheapest level (wall time over all cases) within %g m/s of the finest level in every case'
+           'rule': 'the cheapest level (wall time over all cases) within %g m/s of the finest level run in every case'
            % tolerance}
     if not complete:
         out['why'] = 'no level ran every case'
         return out
-    reference = complete[0]
+    out['reference_level'] = complete[0]
     within = [l for l in complete
-              if all(abs(ran[l][c]['speed_made_good'] - ran[reference][c]['speed_made_good']) <= tolerance
+              if all(abs(ran[l][c]['speed_made_good'] - ran[finest[c]][c]['speed_made_good']) <= tolerance
                      for c in cases)]
+    if not within:
+        out['why'] = ('no level that ran every case is within %g m/s of the finest run in every case' % tolerance)
+        return out
     chosen = min(within, key=lambda l: levels[l]['wall_time'])
     out['default_level'] = chosen
-    out['reference_level'] = reference
-    out['provisional'] = len(complete) < 2
-    if out['provisional']:
-        out['why'] = 'only %s ran every case: nothing to compare it with' % reference
+    alone = ['%g deg, CI %g' % c for c in cases if finest[c] == chosen]
+    out['provisional'] = bool(alone)
+    if alone:
+        out['why'] = '%s is the finest level run at %s: its own error is not measured' % (chosen, '; '.join(alone))
     return out
 
 

@@ -40,17 +40,26 @@ class LevelSummary(unittest.TestCase):
         s = study.level_summary(rows_of({(12, 100): {'coarse': (6.0, 7000), 'tiny': (6.5, 1700)},
                                          (0, 50): {'coarse': (8.0, 9000), 'tiny': (9.2, 2400)}}))
         self.assertEqual(s['default_level'], 'coarse')
+        self.assertTrue(s['provisional'])  # coarse is the finest run: its own error not measured
         self.assertAlmostEqual(s['levels']['tiny']['speed_error'], 1.2)
 
-    def test_a_level_that_did_not_run_every_case_is_neither_reference_nor_candidate(self):
-        # medium ran one case only: coarse is the reference of the rule; tiny's error in that case
-        # is still measured against medium (the finest run of that case)
+    def test_a_level_that_did_not_run_every_case_is_no_candidate_but_rules_out_those_off_in_its_case(self):
+        # medium ran one case only: not a candidate, but that case's reference. Tiny is 1.5 m/s off
+        # medium there (out), coarse 1.0 (in); coarse is the finest run at (0, 50): provisional
         s = study.level_summary(rows_of({(12, 100): {'medium': (5.0, 20000), 'coarse': (6.0, 7000), 'tiny': (6.5, 1700)},
                                          (0, 50): {'coarse': (8.0, 9000), 'tiny': (8.5, 2400)}}))
         self.assertEqual(s['reference_level'], 'coarse')
-        self.assertEqual(s['default_level'], 'tiny')
+        self.assertEqual(s['default_level'], 'coarse')
+        self.assertTrue(s['provisional'])
+        self.assertIn('0 deg, CI 50', s['why'])
         self.assertAlmostEqual(s['levels']['tiny']['speed_error'], 1.5)
         self.assertEqual(s['levels']['tiny']['reference'], ['coarse', 'medium'])
+        # with medium 1.2 m/s below coarse, neither complete level is within 1 m/s there
+        s = study.level_summary(rows_of({(12, 100): {'medium': (4.8, 20000), 'coarse': (6.0, 7000), 'tiny': (6.5, 1700)},
+                                         (0, 50): {'coarse': (8.0, 9000), 'tiny': (8.5, 2400)}}))
+        self.assertIsNone(s['default_level'])
+        self.assertIn('no level that ran every case', s['why'])
+        self.assertIn('no default level', study.summary_text(s))
 
     def test_a_single_level_gives_only_a_provisional_choice(self):
         s = study.level_summary(rows_of({(12, 100): {'tiny': (6.5, 1700)}}))
