@@ -74,6 +74,39 @@ def check(case, result):
     return None
 
 
+def same_run(a):
+    """accept(case, old result) for --resume: a result of this scene, level, grade and cone index."""
+    def accept(case, old):
+        try:
+            return (os.path.realpath(str(old.get('scene'))) == os.path.realpath(a.scene)
+                    and old.get('fidelity') == case['level']
+                    and abs(float(old.get('grade_deg')) - case['grade']) < 1e-9
+                    and abs(float(old.get('requested_cone_index_psi')) - case['ci']) < 1e-9)
+        except (TypeError, ValueError):
+            return False
+    return accept
+
+
+OPTIONS_FILE = 'study_options.yaml'
+
+
+def check_options(a, out):
+    """The options a result depends on and no result file holds (the driving time, the runner),
+    kept in OUT; --resume with others is refused naming the option."""
+    now = {'scene': os.path.abspath(a.scene), 'duration': a.duration, 'runner': a.runner}
+    path = os.path.join(out, OPTIONS_FILE)
+    if a.resume and os.path.exists(path):
+        with open(path) as fh:
+            old = yaml.safe_load(fh) or {}
+        for key, v in now.items():
+            if old.get(key) != v:
+                raise SystemExit('soil_fidelity_study.py: --resume: %s holds runs made with --%s %s, not %s'
+                                 % (out, key.replace('_', '-'), old.get(key), v))
+    os.makedirs(out, exist_ok=True)
+    with open(path, 'w') as fh:
+        yaml.safe_dump(now, fh, sort_keys=False)
+
+
 def number(x):
     try:
         return float(x)
@@ -274,7 +307,9 @@ def main():
         command = lambda case, o: core_command(a, case, o.result_file)  # noqa: E731
     else:
         command = lambda case, o: roslaunch_command(a, case, o.port)  # noqa: E731
-    sweep = dm_sweep.run_sweep(cases, command, os.path.join(a.out, 'runs'), resume=a.resume, jobs=a.jobs,
+    check_options(a, a.out)
+    sweep = dm_sweep.run_sweep(cases, command, os.path.join(a.out, 'runs'), resume=a.resume, accept=same_run(a),
+                               jobs=a.jobs,
                                port=a.port, timeout=a.timeout, check=check, accept_status=STATUSES,
                                summary=os.path.join(a.out, 'sweep.yaml'))
     rows = summarize(sweep, a.cases)

@@ -3,8 +3,11 @@ and the default level by the issue's rule (the cheapest within 1 m/s of the fine
 
     python3 -m unittest discover -s test/python -v      (from the repository root)
 """
+import argparse
 import os
+import shutil
 import sys
+import tempfile
 import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -67,6 +70,42 @@ class LevelSummary(unittest.TestCase):
         self.assertTrue(s['provisional'])
         self.assertIn('no default level', study.summary_text(study.level_summary([])))
         self.assertIn('provisional', study.summary_text(s))
+
+
+class Resume(unittest.TestCase):
+    """--resume keeps a run only if it is of this scene, level, grade and cone index, and refuses a
+    folder whose runs were made with another driving time, runner or scene."""
+
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix='dm_fidelity_')
+        self.scene = os.path.join(ROOT, 'config', 'scenes', 'soil_slope.yaml')
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def args(self, **kw):
+        a = dict(scene=self.scene, duration=40.0, runner='core', resume=False)
+        a.update(kw)
+        return argparse.Namespace(**a)
+
+    def test_only_a_result_of_the_same_case_is_kept(self):
+        accept = study.same_run(self.args())
+        case = {'level': 'coarse', 'grade': 0.0, 'ci': 50.0}
+        good = {'scene': self.scene, 'fidelity': 'coarse', 'grade_deg': 0, 'requested_cone_index_psi': 50}
+        self.assertTrue(accept(case, good))
+        for key, v in (('scene', '/elsewhere/soil_slope.yaml'), ('fidelity', 'tiny'), ('grade_deg', 12),
+                       ('requested_cone_index_psi', 100), ('grade_deg', None)):
+            self.assertFalse(accept(case, dict(good, **{key: v})), key)
+
+    def test_a_resume_with_another_driving_time_is_refused_naming_it(self):
+        study.check_options(self.args(), self.tmp)
+        study.check_options(self.args(resume=True), self.tmp)  # the same: fine
+        with self.assertRaises(SystemExit) as e:
+            study.check_options(self.args(resume=True, duration=10.0), self.tmp)
+        self.assertIn('--duration 40.0, not 10.0', str(e.exception))
+        with self.assertRaises(SystemExit) as e:
+            study.check_options(self.args(resume=True, runner='roslaunch'), self.tmp)
+        self.assertIn('--runner core', str(e.exception))
 
 
 if __name__ == '__main__':
