@@ -85,6 +85,9 @@ def cells_of(a):
     if a.ci:
         ci = cells.min_cone_index(raster.read(a.ci, 'cone index'))
         source = a.ci
+        if np.isnan(np.where(np.isnan(slope), np.nan, ci)).all():
+            raise UsageError('%s: the cone index raster has no value in any cell of the elevation %s (another '
+                             'region, or all nodata)' % (a.ci, a.elevation))
         if np.nanmin(ci) <= 0:
             raise UsageError('%s: cone index %.3g psi: a cone index must be positive' % (a.ci, np.nanmin(ci)))
     else:
@@ -114,18 +117,36 @@ def write_table(path_stem, grid, rows, provenance):
 
 
 def read_table(path):
+    """A case table (doe run's doe_table.yaml, doe nrmm's nrmm_table.yaml): its grades, cone
+    indices and the speed matrix (a row per grade), checked; UsageError naming the file."""
     try:
         with open(path) as fh:
             doc = yaml.safe_load(fh)
     except OSError as e:
         raise UsageError('%s: cannot read the table (%s)' % (path, e.strerror))
+    except yaml.YAMLError as e:
+        raise UsageError('%s: not YAML (%s)' % (path, str(e).replace('\n', ' ')))
     for k in ('grades', 'cone_indices', 'speed'):
         if not isinstance(doc, dict) or k not in doc:
             raise UsageError('%s: not a case table (no %s)' % (path, k))
-    s = np.array([[np.nan if v is None else v for v in row] for row in doc['speed']], dtype=float)
+    try:
+        plan.Grid(doc['grades'], doc['cone_indices'])
+    except (plan.PlanError, TypeError, ValueError) as e:
+        raise UsageError('%s: grades/cone_indices: %s' % (path, e))
+    rows = doc['speed']
+    shape = (len(doc['grades']), len(doc['cone_indices']))
+    if not isinstance(rows, list) or len(rows) != shape[0] or \
+            any(not isinstance(row, list) or len(row) != shape[1] for row in rows):
+        raise UsageError('%s: speed: not a %d x %d matrix (a row of %d speeds per grade)' % (path, shape[0], shape[1],
+                                                                                             shape[1]))
+    try:
+        s = np.array([[np.nan if v is None else float(v) for v in row] for row in rows], dtype=float)
+    except (TypeError, ValueError) as e:
+        raise UsageError('%s: speed: a value that is not a number (%s)' % (path, e))
     if np.isnan(s).any():
         raise UsageError('%s: the table has cases without a speed (the DOE is not finished)' % path)
-    plan.Grid(doc['grades'], doc['cone_indices'])
+    if (s < 0).any() or not np.isfinite(s).all():
+        raise UsageError('%s: speed: a speed below 0 or infinite' % path)
     return dict(doc, speed=s)
 
 
@@ -189,6 +210,7 @@ def cmd_nrmm(a):
 
 def cmd_map(a):
     table = read_table(a.table)
+    other = read_table(a.compare) if a.compare else None  # refused before anything is written
     cells, slope, ci, source = cells_of(a)
     os.makedirs(a.out, exist_ok=True)
     t0 = time.time()
@@ -210,8 +232,7 @@ def cmd_map(a):
               'cells': list(cells.shape), 'cell_size': cells.cell_size, 'oversample': cells.oversample,
               'reprojected_to_utm': cells.reprojected, 'interpolation_wall_time': round(t_map, 4),
               'cells_beyond_the_table': beyond, 'outputs': out}
-    if a.compare:
-        other = read_table(a.compare)
+    if other is not None:
         s2 = maps.speed_map(other, slope, ci, clamp_ci=a.clamp_ci)
         diff = speed - s2
         dname = '%s_minus_%s' % (label, other.get('model', 'other'))
@@ -568,7 +589,7 @@ def parser():
     map_args(p)
     p.add_argument('--table', required=True, help='a case table (YAML: doe nrmm, or a finished DOE)')
     p.add_argument('--compare', help='another table: writes the difference map (table minus it)')
-    p.add_argument('--clamp-ci', action='store_true', help='take CIs beyond the table as its last column')
+    p.add_argument('--clamp-ci', action='store_true', help='take CIs above the table\'s highest as its last column (a CI below its lowest keeps no value)')
     p.add_argument('--top-speed', type=float, help='the ROS map\'s free speed [m/s] (default: the table\'s highest)')
     p.add_argument('--name', help='file name stem of the map')
     p.add_argument('--out', required=True, help='output folder')

@@ -4,8 +4,9 @@
 The table is speed[i][j] at grades[i] [deg] and cone_indices[j] [psi], both rising. A cell whose
 grade or CI lies outside the table's range has no value (NaN): the table says nothing there, and
 a map must not pretend it does. `clamp_ci` (off by default) takes a CI above the table's highest
-as that highest (soil stronger than the strongest simulated behaves at least as well) and one
-below the lowest as the lowest; grades are never clamped.
+as that highest (soil stronger than the strongest simulated behaves at least as well: a
+conservative speed); a CI below the lowest keeps no value (softer soil than any simulated could
+be slower than the softest: taking its speed would be optimistic); grades are never clamped.
 """
 import numpy as np
 
@@ -21,7 +22,7 @@ def bilinear(grades, cone_indices, speed, g, ci, clamp_ci=False):
     g = np.asarray(g, dtype=float)
     ci = np.asarray(ci, dtype=float)
     if clamp_ci:
-        ci = np.clip(ci, cx[0], cx[-1])
+        ci = np.minimum(ci, cx[-1])
     inside = (g >= gx[0]) & (g <= gx[-1]) & (ci >= cx[0]) & (ci <= cx[-1])
 
     def locate(axis, x):

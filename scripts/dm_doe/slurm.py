@@ -7,6 +7,7 @@ completion log, jobcomp/filetxt: finished tasks, by their raw job ids) joined wi
 for the array task ids; else `squeue -t all` alone (tasks within MinJobAge). The results always
 come from the cases' own files.
 """
+import math
 import os
 import shlex
 import subprocess
@@ -73,7 +74,7 @@ def submit(out, doc, indices, parallel, partition=None, time_limit=None, extra=(
     if partition:
         argv += ['--partition', partition]
     if time_limit:
-        argv += ['--time', '%d' % max(1, int(round(time_limit / 60.0)))]
+        argv += ['--time', '%d' % max(1, math.ceil(time_limit / 60.0))]  # whole minutes, never below the limit
     argv += list(extra) + [script]
     p = _call(argv, 'sbatch')
     if p.returncode != 0:

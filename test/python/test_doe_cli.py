@@ -111,6 +111,46 @@ class Doe(unittest.TestCase):
         self.assertIn('cone index 200 psi: outside the tiny level', err)
         self.assertIn('cone_index_mu0.1_d0.1.yaml', err)
 
+    def test_a_bad_table_is_refused_naming_it_before_any_map_is_written(self):
+        good = {'grades': [0.0, 12.0], 'cone_indices': [30.0, 300.0], 'speed': [[10.0, 20.0], [5.0, 15.0]]}
+        cases = (('not_yaml', 'grades: [0, 12\n', 'not YAML'),
+                 ('rows', dict(good, speed=[[10.0, 20.0]]), 'speed: not a 2 x 2 matrix'),
+                 ('columns', dict(good, speed=[[10.0], [5.0, 15.0]]), 'speed: not a 2 x 2 matrix'),
+                 ('text', dict(good, speed=[[10.0, 'fast'], [5.0, 15.0]]), 'speed: a value that is not a number'),
+                 ('negative', dict(good, speed=[[10.0, -1.0], [5.0, 15.0]]), 'speed: a speed below 0'),
+                 ('grades', dict(good, grades=[12.0, 0.0]), 'grades/cone_indices:'),
+                 ('no_speed', {'grades': [0.0]}, 'not a case table'))
+        for name, doc, what in cases:
+            path = os.path.join(self.tmp, name + '_table.yaml')
+            with open(path, 'w') as fh:
+                fh.write(doc if isinstance(doc, str) else yaml.safe_dump(doc))
+            out = os.path.join(self.tmp, 'map_' + name)
+            for args in (['--table', path], ['--table', self.good_table(good), '--compare', path]):
+                rc, _, err = doe('map', *args, '--elevation', ST_HELENS, '--out', out)
+                self.assertEqual(rc, 2, (name, err))
+                self.assertIn(path + ': ' + what, err)
+                self.assertFalse(os.path.exists(out), name)
+
+    def good_table(self, doc):
+        path = os.path.join(self.tmp, 'good_table.yaml')
+        with open(path, 'w') as fh:
+            yaml.safe_dump(doc, fh)
+        return path
+
+    def test_a_cone_index_raster_beside_the_elevation_is_refused(self):
+        # a CI raster 100 km east of the elevation's cells: no cell has a cone index
+        src = gdal.Open(ST_HELENS)
+        gt = list(src.GetGeoTransform())
+        gt[0] += 100000.0
+        ci = os.path.join(self.tmp, 'ci_elsewhere.tif')
+        raster.write_geotiff(ci, np.full((20, 20), 100.0), tuple(gt), src.GetProjection())
+        table = self.good_table({'grades': [0.0, 45.0], 'cone_indices': [30.0, 300.0],
+                                 'speed': [[10.0, 20.0], [5.0, 15.0]]})
+        out = os.path.join(self.tmp, 'map_ci_elsewhere')
+        rc, _, err = doe('map', '--table', table, '--elevation', ST_HELENS, '--ci', ci, '--out', out)
+        self.assertEqual(rc, 2, err)
+        self.assertIn('ci_elsewhere.tif: the cone index raster has no value in any cell', err)
+
 
 if __name__ == '__main__':
     unittest.main()

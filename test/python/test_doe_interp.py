@@ -36,13 +36,15 @@ class Bilinear(unittest.TestCase):
         g, c = rng.uniform(G[4], G[5], 500), rng.uniform(C[7], C[8], 500)
         np.testing.assert_allclose(interp.bilinear(G, C, t, g, c), f(g, c), atol=1e-12)
 
-    def test_outside_the_table_is_nan_unless_the_ci_is_clamped(self):
+    def test_outside_the_table_is_nan_unless_the_ci_is_clamped_from_above(self):
         table = np.ones((G.size, C.size))
+        table[:, -1] = 2.0  # the strongest soil's column
         out = interp.bilinear(G, C, table, np.array([40.0, 10.0, 10.0, np.nan]), np.array([100.0, 20.0, 400.0, 100.0]))
         self.assertTrue(np.isnan(out).all())
+        # a CI above the table takes its strongest column; one below it (softer than any case) none
         clamped = interp.bilinear(G, C, table, np.array([40.0, 10.0, 10.0]), np.array([100.0, 20.0, 400.0]),
                                   clamp_ci=True)
-        np.testing.assert_array_equal(clamped, [np.nan, 1.0, 1.0])
+        np.testing.assert_array_equal(clamped, [np.nan, np.nan, 2.0])
 
     def test_a_single_grade_interpolates_along_ci(self):
         out = interp.bilinear([12.0], [30.0, 50.0], [[2.0, 6.0]], np.array([12.0, 12.0]), np.array([40.0, 50.0]))

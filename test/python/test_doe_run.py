@@ -428,5 +428,26 @@ class SlurmDoe(unittest.TestCase):
         self.assertEqual(slurm.ranges([4]), '4')
 
 
+class SlurmSubmit(unittest.TestCase):
+    """The sbatch command line (sbatch itself replaced: what it is given)."""
+
+    def test_the_time_limit_is_whole_minutes_never_below_the_timeout(self):
+        tmp = tempfile.mkdtemp(prefix='dm_doe_sbatch_')
+        self.addCleanup(shutil.rmtree, tmp, True)
+        doc = runner.make_plan(plan.Grid([0.0], [300.0]), 'tiny', 'core', 1, 5.0, True, lambda g, c: 1.0)
+        given = []
+
+        def sbatch(argv, what):
+            given.append(argv)
+            return subprocess.CompletedProcess(argv, 0, '4%d\n' % len(given), '')
+        real = slurm._call
+        slurm._call = sbatch
+        self.addCleanup(setattr, slurm, '_call', real)
+        for timeout, minutes in ((150.0, '3'), (120.0, '2'), (10.0, '1')):
+            slurm.submit(tmp, doc, [0], 1, time_limit=timeout)
+            argv = given[-1]
+            self.assertEqual(argv[argv.index('--time') + 1], minutes, timeout)
+
+
 if __name__ == '__main__':
     unittest.main()
