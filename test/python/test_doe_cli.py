@@ -6,6 +6,7 @@ outside the level's calibration range).
     python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -17,7 +18,7 @@ import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import nrmm, raster  # noqa: E402
+from dm_doe import interp, nrmm, raster  # noqa: E402
 from osgeo import gdal, osr  # noqa: E402
 
 DOE = os.path.join(ROOT, 'scripts', 'doe')
@@ -67,6 +68,15 @@ class Doe(unittest.TestCase):
         self.assertEqual((gt[1], gt[5]), (20.0, -20.0))
         diff = raster.read(os.path.join(m, 'nrmm_minus_nrmm.tif'))
         self.assertEqual(np.nanmax(np.abs(diff.values)), 0.0)   # a table against itself
+        # every cell's speed is the table at that cell's own slope and CI (the cells' rasters), so
+        # the two are not swapped nor the cells shifted; the map is float32
+        smg = raster.read(os.path.join(m, 'nrmm_smg.tif')).values
+        slope = raster.read(os.path.join(m, 'cells_max_slope_deg.tif')).values
+        ci = raster.read(os.path.join(m, 'cells_min_ci_psi.tif')).values
+        want = interp.bilinear(t['grades'], t['cone_indices'], t['speed'], slope, ci)
+        self.assertGreater(np.sum(~np.isnan(want)), 1000)
+        np.testing.assert_array_equal(np.isnan(smg), np.isnan(want))
+        np.testing.assert_allclose(smg[~np.isnan(want)], want[~np.isnan(want)].astype(np.float32), rtol=0, atol=1e-5)
         for f in ('nrmm_smg.png', 'nrmm_smg_ros.yaml', 'nrmm_smg_ros.png', 'nrmm_minus_nrmm.png', 'map.yaml'):
             self.assertTrue(os.path.exists(os.path.join(m, f)), f)
 
@@ -76,6 +86,24 @@ class Doe(unittest.TestCase):
         self.assertIn('left out', out)                 # the paper's CIs beyond the tiny table
         self.assertIn('every case run:', out)
         self.assertIn('with pruning:', out)
+        # 2 grades x (CI 50, the road): the bound "if none ended early" worked out from the measured
+        # costs (a soil run: preparation + (settling + 40 s) x wall per simulated second; a road run
+        # without preparation); every case run costs no more, the pruned plan no more than that
+        with open(os.path.join(ROOT, 'config', 'doe', 'run_costs.yaml')) as fh:
+            c = yaml.safe_load(fh)
+        sim = c['settle'] + c['duration']
+        upper = 2 * (c['levels']['tiny']['prepare'] + sim * c['levels']['tiny']['wall_per_sim_s']) + \
+            2 * sim * c['road']['wall_per_sim_s']
+        rc, out, se = doe('plan', '--level', 'tiny', '--grades', '0,12', '--cone-indices', '50,300')
+        self.assertEqual(rc, 0, se)
+        full = re.search(r'every case run: +([0-9.]+) h \(4 runs; at most ([0-9.]+) h', out)
+        pruned = re.search(r'with pruning: +([0-9.]+) h \((\d+) runs, (\d+) implied', out)
+        self.assertIsNotNone(full, out)
+        self.assertIsNotNone(pruned, out)
+        self.assertAlmostEqual(float(full.group(2)), upper / 3600, delta=0.05)
+        self.assertLessEqual(float(full.group(1)), float(full.group(2)))
+        self.assertLessEqual(float(pruned.group(1)), float(full.group(1)))
+        self.assertEqual(int(pruned.group(2)) + int(pruned.group(3)), 4)
 
     def test_a_map_grid_spans_the_map_within_what_the_level_and_the_scenes_take(self):
         rc, out, se = doe('plan', '--grid', 'map', '--grid-size', '5x4', '--elevation', ST_HELENS, '--level', 'tiny')

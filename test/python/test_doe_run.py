@@ -86,7 +86,6 @@ class Decisions(unittest.TestCase):
         self.assertIsNone(runner.decide(self.by_cell[(2, 0)], self.doc, st))
 
 
-@unittest.skipUnless(os.access(DM_RUN_SCENE, os.X_OK), 'no dm_run_scene at %s (build the core first)' % DM_RUN_SCENE)
 class CaseCommands(unittest.TestCase):
     """What a case runs: the launch file (or dm_run_scene) with the DOE's grade, level, CI, threads
     and duration, and the user's scene file where the plan has one (--soil-scene)."""
