@@ -202,4 +202,29 @@ def reconcile(out, doc):
         lines.append('slurm job %s: %s (from %s)%s' % (
             job, ', '.join('%d %s' % (n, k) for k, n in sorted(counts.items())) or 'no task known (finished long ago?)',
             source, '; %d ended without a result: recorded failed' % len(lost) if lost else ''))
+    lines += record_forgotten_tasks(out, doc)
     return active, lines
+
+
+def record_forgotten_tasks(out, doc):
+    """A `running` marker of a Slurm task (its raw job id in the marker) whose job Slurm no longer
+    has pending or running: squeue lists it no more (it forgets a finished job after MinJobAge,
+    and without accounting sacct cannot name it), so the task ended; its case is recorded failed
+    (a result there by now is never replaced). Without this a task killed on another host would
+    leave a marker that counts as alive for ever. Returns the lines to print."""
+    lines = []
+    for k, (state, _) in sorted(runner.scan(out, doc).items()):
+        if state != 'running':
+            continue
+        case = doc['cases'][k]
+        rid = (runner.read_result(runner.marker_path(out, case)) or {}).get('slurm_job')
+        if not rid:
+            continue
+        p = _call(['squeue', '-h', '-j', str(rid), '-o', '%T'], 'squeue')
+        gone = (p.returncode == 0 and not p.stdout.strip()) or (p.returncode != 0 and 'Invalid job id' in p.stderr)
+        if gone and runner.record_failure(out, doc, case, 'its Slurm task (job %s) ended without the case\'s result; '
+                                          'see %s' % (rid, os.path.join(out, 'slurm', '*_%d.out' % k)),
+                                          kind='doe_task'):
+            lines.append('%s: its Slurm task (job %s) is no longer pending or running: recorded failed'
+                         % (case['name'], rid))
+    return lines

@@ -422,6 +422,27 @@ class SlurmDoe(unittest.TestCase):
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
 
+    def test_a_task_slurm_no_longer_knows_leaves_no_running_case(self):
+        # a marker of a task on another host whose job Slurm does not have (forgotten after
+        # MinJobAge, no accounting): status records the case failed instead of running for ever;
+        # a marker without a Slurm job (a pool worker elsewhere) stays running
+        tmp = tempfile.mkdtemp(prefix='dm_doe_slurm_')
+        self.addCleanup(shutil.rmtree, tmp, True)
+        out = os.path.join(tmp, 'forgotten')
+        os.makedirs(runner.runs_dir(out))
+        doc = runner.make_plan(plan.Grid([0.0, 1.0], [300.0]), 'tiny', 'core', 1, 5.0, False, lambda g, c: 1.0)
+        runner.write_yaml(os.path.join(out, runner.PLAN_FILE), doc)
+        a, b = doc['cases']
+        runner.write_yaml(runner.marker_path(out, a), {'host': 'elsewhere', 'pid': 1, 'slurm_job': '987654'})
+        runner.write_yaml(runner.marker_path(out, b), {'host': 'elsewhere', 'pid': 1, 'slurm_job': None})
+        with LocalCluster() as c:
+            rc, so, se = doe('status', '--out', out, env=c.env)
+        self.assertIn('%s: its Slurm task (job 987654) is no longer pending or running: recorded failed' % a['name'],
+                      so + se)
+        states = runner.scan(out, doc)
+        self.assertEqual((states[a['index']][0], states[b['index']][0]), ('failed', 'running'))
+        self.assertIn('job 987654', states[a['index']][1]['error'])
+
     def test_array_ranges(self):
         self.assertEqual(slurm.ranges([0, 1, 2, 3, 5, 7, 8]), '0-3,5,7-8')
         self.assertEqual(slurm.ranges([4]), '4')
