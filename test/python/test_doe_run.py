@@ -362,7 +362,8 @@ class SlurmDoe(unittest.TestCase):
             rows = {(r['grade_deg'], r['cone_index']): r for r in a['cases_table']}
             for (g, c), r in rows.items():
                 self.assertEqual(r['source'], 'simulated (%s, %s)' % (('road', 'rigid road') if c == 300 else ('soil', 'tiny')))
-                self.assertTrue(r['speed_made_good'] == r['speed_made_good'], (g, c))  # a number, not NaN
+                v = r['speed_made_good']
+                self.assertTrue(isinstance(v, float) and v == v, (g, c, v))  # a number, not None nor NaN
             # the soil cases ran the given scene: the tracks' strips, the 6 m box, the grade and CI the DOE set
             res = load(os.path.join(local, 'runs', 'g12_ci50.result.yaml'))
             self.assertEqual((res['grade_deg'], res['patch_track_strip_width'], res['fidelity']), (12.0, 0.6, 'tiny'))
