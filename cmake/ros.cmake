@@ -26,7 +26,8 @@ catkin_package(
     tf2_msgs topic_tools visualization_msgs
 )
 install(DIRECTORY include/${PROJECT_NAME}/ DESTINATION ${CATKIN_PACKAGE_INCLUDE_DESTINATION})
-catkin_install_python(PROGRAMS scripts/plot_speed.py scripts/plot_compression.py scripts/calibrate_cone_index.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+catkin_install_python(PROGRAMS scripts/plot_speed.py scripts/plot_compression.py scripts/calibrate_cone_index.py
+  scripts/publish_map.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)
   find_package(rostest REQUIRED)
@@ -43,6 +44,7 @@ if(CATKIN_ENABLE_TESTING)
   roslaunch_add_file_check(launch/components/driver.launch)
   roslaunch_add_file_check(launch/components/recorder.launch bag:=/tmp/run.bag)
   roslaunch_add_file_check(launch/bench/cosim_exchange.launch)
+  roslaunch_add_file_check(launch/mobility_map.launch map:=/tmp/map.yaml)
   roslaunch_add_file_check(test/ros/road_scene.test)
   add_rostest(test/ros/road_scene.test)
 endif()

@@ -96,16 +96,31 @@ class BagRecorderNodelet : public nodelet::Nodelet {
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
-    std::vector<std::string> topics, stream;
+    std::vector<std::string> topics, stream, latched;
     std::string end;
+    // every parameter checked before the bag is made: a parameter of the wrong type is an error
+    // naming it, never its default
+    auto set_but_not = [&pnh](const char* name, bool got) { return pnh.hasParam(name) && !got; };
     if (!pnh.getParam("bag", path_) || path_.empty()) return Fatal("parameter " + pnh.resolveName("bag") + " is not set");
     if (!pnh.getParam("topics", topics) || topics.empty())
       return Fatal("parameter " + pnh.resolveName("topics") + " (the list of topics to record) is not set");
-    pnh.getParam("stream_topics", stream);
-    std::vector<std::string> latched;
-    pnh.getParam("latched_topics", latched);
-    pnh.param<std::string>("end_topic", end, "");
-    pnh.param("shutdown_when_done", shutdown_when_done_, false);
+    // without a stream topic nothing could be written before the end: the whole run held in memory
+    if (!pnh.getParam("stream_topics", stream) || stream.empty())
+      return Fatal("parameter " + pnh.resolveName("stream_topics") +
+                   " (the topics published all run long, which order the bag) is not a list of topics");
+    if (set_but_not("latched_topics", pnh.getParam("latched_topics", latched)))
+      return Fatal("parameter " + pnh.resolveName("latched_topics") + " is not a list of topics");
+    if (set_but_not("end_topic", pnh.getParam("end_topic", end)))
+      return Fatal("parameter " + pnh.resolveName("end_topic") + " is not a topic name");
+    if (set_but_not("shutdown_when_done", pnh.getParam("shutdown_when_done", shutdown_when_done_)))
+      return Fatal("parameter " + pnh.resolveName("shutdown_when_done") + " is not true or false");
+    for (const auto& [name, list] : {std::pair<const char*, const std::vector<std::string>*>{"stream_topics", &stream},
+                                     {"latched_topics", &latched}})
+      for (const std::string& s : *list)
+        if (std::find(topics.begin(), topics.end(), s) == topics.end())
+          return Fatal("parameter " + pnh.resolveName(name) + ": '" + s + "' is not in ~topics");
+    if (!end.empty() && std::find(topics.begin(), topics.end(), end) == topics.end())
+      return Fatal("parameter " + pnh.resolveName("end_topic") + ": '" + end + "' is not in ~topics");
     // a file size limit (ulimit -f) fails the bag's writes (EFBIG) instead of killing the process
     std::signal(SIGXFSZ, SIG_IGN);
     error_ = nh.advertise<std_msgs::String>("recorder/error", 1, true);
@@ -125,11 +140,6 @@ class BagRecorderNodelet : public nodelet::Nodelet {
       t.latched = std::find(latched.begin(), latched.end(), topics[i]) != latched.end();
       if (topics[i] == end) end_index_ = static_cast<int>(i);
     }
-    for (const std::string& s : stream)
-      if (std::find(topics.begin(), topics.end(), s) == topics.end())
-        return Fatal("parameter " + pnh.resolveName("stream_topics") + ": '" + s + "' is not in ~topics");
-    if (!end.empty() && end_index_ < 0)
-      return Fatal("parameter " + pnh.resolveName("end_topic") + ": '" + end + "' is not in ~topics");
     // unbounded queues (0): in this process nothing is dropped
     // the callback takes the message event, so that it has the connection header (who published,
     // whether the publisher latches): bound to a plain message pointer it would not
@@ -208,15 +218,14 @@ class BagRecorderNodelet : public nodelet::Nodelet {
       return;
     }
     // a message older than the newest of every stream topic can no longer be preceded by another
+    // (there is one at least: ~stream_topics must name one)
     ros::Time safe = ros::TIME_MAX;
-    bool any_stream = false;
     for (const Topic& s : topics_) {
       if (!s.stream) continue;
-      any_stream = true;
       if (!s.seen) return;
       safe = std::min(safe, s.latest);
     }
-    if (any_stream) WriteOrFail(safe);
+    WriteOrFail(safe);
   }
 
   /// Write, and on failure (the disk full, the file size limit, an I/O error) the error said on

@@ -1,5 +1,8 @@
 #include "dem_mobility/ros/conversions.h"
 
+#include <cmath>
+#include <cstdlib>
+
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/ros/core_names.h"
@@ -164,18 +167,41 @@ YamlReader LoadSceneFile(const ros::NodeHandle& nh) {
   return YamlReader::LoadWithOverrides(file, overrides);
 }
 
+bool NumberFromString(const ros::NodeHandle& nh, const std::string& name, double* value) {
+  std::string text;
+  if (!nh.getParam(name, text) || text.empty()) return false;
+  char* end = nullptr;
+  const double x = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size()) return false;
+  *value = x;
+  return true;
+}
+
+void RateParam(const ros::NodeHandle& nh, const std::string& name, double* value, const char* zero) {
+  Param(nh, name, value);
+  const double r = *value;
+  if (zero && r == 0.0) return;
+  if (!(std::isfinite(r) && r >= 1e-6 && r <= 1e9))
+    throw ConfigError("parameter " + nh.resolveName(name) + ": " + std::to_string(r) + " Hz: a rate is from 1e-6 to 1e9 Hz" +
+                      (zero ? std::string(" (0: ") + zero + ")" : std::string()));
+}
+
 ExchangeTiming LoadExchangeTiming(const ros::NodeHandle& pnh, std::string* transport) {
   ExchangeTiming t;
-  pnh.param<std::string>("exchange_transport", *transport, "inline");
-  pnh.param("exchange_spin", t.spin, t.spin);
-  pnh.param("peer_timeout", t.peer_timeout, t.peer_timeout);
-  pnh.param("startup_timeout", t.startup_timeout, t.startup_timeout);
+  *transport = "inline";
+  Param(pnh, "exchange_transport", transport);
+  Param(pnh, "exchange_spin", &t.spin);
+  Param(pnh, "peer_timeout", &t.peer_timeout);
+  Param(pnh, "startup_timeout", &t.startup_timeout);
   if (*transport != "inline" && *transport != "shared_memory" && *transport != "topics")
     throw ConfigError("parameter " + pnh.resolveName("exchange_transport") + ": '" + *transport +
                       "' is not a transport (inline, shared_memory or topics)");
   if (!(t.spin >= 0.0 && t.spin <= 1.0)) throw ConfigError("parameter " + pnh.resolveName("exchange_spin") + " must be in [0, 1] s");
-  if (!(t.peer_timeout > 0.0)) throw ConfigError("parameter " + pnh.resolveName("peer_timeout") + " must be positive");
-  if (!(t.startup_timeout > 0.0)) throw ConfigError("parameter " + pnh.resolveName("startup_timeout") + " must be positive");
+  // (at most about 30 years: the timeouts become whole nanoseconds in an int64)
+  if (!(t.peer_timeout > 0.0 && t.peer_timeout <= 1e9))
+    throw ConfigError("parameter " + pnh.resolveName("peer_timeout") + " must be in (0, 1e9] s");
+  if (!(t.startup_timeout > 0.0 && t.startup_timeout <= 1e9))
+    throw ConfigError("parameter " + pnh.resolveName("startup_timeout") + " must be in (0, 1e9] s");
   return t;
 }
 

@@ -34,11 +34,7 @@ class SoilRigNodelet : public nodelet::Nodelet {
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
-    pnh.param<std::string>("frame_id", frame_id_, "map");
-    pnh.param<std::string>("result_file", result_file_, "");
-    pnh.param("cloud_rate", cloud_rate_, cloud_rate_);
-    pnh.param("clock_rate", clock_rate_, clock_rate_);
-    pnh.param("wait_for_recorder", wait_for_recorder_, true);
+    pnh.getParam("result_file", result_file_);  // first: a bad parameter is reported there too
     ros::NodeHandle root;
     clock_ = root.advertise<rosgraph_msgs::Clock>("/clock", 10);
     markers_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/markers", 1, true);
@@ -47,6 +43,9 @@ class SoilRigNodelet : public nodelet::Nodelet {
     section_ = nh.advertise<sensor_msgs::PointCloud2>("terrain/particles_section", 2);
     std::string kind;
     try {
+      Param(pnh, "result_file", &result_file_);
+      Param(pnh, "frame_id", &frame_id_);
+      Param(pnh, "wait_for_recorder", &wait_for_recorder_);
       const YamlReader scene = LoadSceneFile(nh);
       scene_file_ = scene.file();
       kind = scene.String("scene");
@@ -55,8 +54,8 @@ class SoilRigNodelet : public nodelet::Nodelet {
         topics_ = MakeRigTopics(kind);
         topics_->Advertise(nh);
       }
-      if (!(cloud_rate_ > 0.0)) throw ConfigError("parameter " + pnh.resolveName("cloud_rate") + " must be > 0 Hz");
-      if (!(clock_rate_ > 0.0)) throw ConfigError("parameter " + pnh.resolveName("clock_rate") + " must be > 0 Hz");
+      RateParam(pnh, "cloud_rate", &cloud_rate_);
+      RateParam(pnh, "clock_rate", &clock_rate_);
       ResultFile::CheckWritable(result_file_, "parameter " + pnh.resolveName("result_file"));
       rig_ = MakeSoilRig(scene);  // ConfigError naming the file and key for a scene that is no rig
     } catch (const std::exception& e) {
@@ -99,11 +98,14 @@ class SoilRigNodelet : public nodelet::Nodelet {
     const double dt = s.dt();
     const long cloud_every = std::max(1L, std::lround(1.0 / (cloud_rate_ * dt)));
     const long clock_every = std::max(1L, std::lround(1.0 / (clock_rate_ * dt)));
-    PublishContainer();
-    PublishFrame();
     const auto wall0 = std::chrono::steady_clock::now();
     auto next_progress = wall0 + std::chrono::seconds(10);
+    // any error of the run (a numerical failure, a display that cannot be built, memory) ends it
+    // with that error in the result: an exception out of this thread would end the whole manager
+    // without a result or a closed bag
     try {
+      PublishContainer();
+      PublishFrame();
       while (!rig_->done()) {
         if (recorder_.failed()) {
           rig_->Fail(recorder_.error());
@@ -127,24 +129,33 @@ class SoilRigNodelet : public nodelet::Nodelet {
         topics_->PublishProgress(*rig_, frame_id_);
         if (k % cloud_every == 0 || rig_->done()) PublishFrame();
       }
-    } catch (const SimulationError& e) {
+    } catch (const std::exception& e) {
       NODELET_ERROR("soil rig: %s", e.what());
       rig_->Fail(e.what());
-      PublishFrame();
-    }
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    const ResultFile result = rig_->Report();
-    if (!result_file_.empty()) {
       try {
-        result.Write(result_file_);
-        NODELET_INFO("result: %s", result_file_.c_str());
-      } catch (const std::exception& e) {
-        NODELET_ERROR("%s", e.what());
+        PublishFrame();  // the state it stopped in
+      } catch (const std::exception& f) {
+        NODELET_ERROR("soil rig: the last frame: %s", f.what());
       }
     }
-    NODELET_INFO("%s: %.2f s simulated in %.1f s; %s", rig_->StatusLine().c_str(), s.time(), wall,
-                 result.error().empty() ? "ok" : result.error().c_str());
-    topics_->PublishResult(*rig_, ros::Time(s.time() + dt), frame_id_, wall);  // the recorder ends the run on it
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    try {
+      const ResultFile result = rig_->Report();
+      if (!result_file_.empty()) {
+        try {
+          result.Write(result_file_);
+          NODELET_INFO("result: %s", result_file_.c_str());
+        } catch (const std::exception& e) {
+          NODELET_ERROR("%s", e.what());
+        }
+      }
+      NODELET_INFO("%s: %.2f s simulated in %.1f s; %s", rig_->StatusLine().c_str(), s.time(), wall,
+                   result.error().empty() ? "ok" : result.error().c_str());
+      topics_->PublishResult(*rig_, ros::Time(s.time() + dt), frame_id_, wall);  // the recorder ends the run on it
+    } catch (const std::exception& e) {
+      NODELET_FATAL("soil rig: the result could not be made: %s", e.what());
+      ros::requestShutdown();
+    }
   }
 
   bool Moving(int w) const {
@@ -206,7 +217,7 @@ class SoilRigNodelet : public nodelet::Nodelet {
 
   std::unique_ptr<SoilRig> rig_;
   std::unique_ptr<RigTopics> topics_;
-  std::string scene_file_, frame_id_, result_file_;
+  std::string scene_file_, frame_id_ = "map", result_file_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
   RecorderWatch recorder_;  ///< the bag recorder's failure ends the run with its error

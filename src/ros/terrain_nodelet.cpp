@@ -52,10 +52,8 @@ class TerrainNodelet : public nodelet::Nodelet {
     try {
       scene = LoadScene(nh);
       timing = LoadExchangeTiming(pnh, &transport);
-      pnh.param<std::string>("frame_id", frame_id_, "odom");
-      pnh.param("cloud_rate", cloud_rate_, cloud_rate_);
-      if (!(cloud_rate_ > 0.0 && std::isfinite(cloud_rate_)))
-        throw ConfigError("parameter " + pnh.resolveName("cloud_rate") + " must be > 0 Hz of simulated time");
+      Param(pnh, "frame_id", &frame_id_);
+      RateParam(pnh, "cloud_rate", &cloud_rate_);
     } catch (const std::exception& e) {
       Refuse(transport, e.what());
       return;

@@ -114,27 +114,26 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
-    pnh.param<std::string>("result_file", result_file_, "");  // first: a bad scene is reported there too
+    pnh.getParam("result_file", result_file_);  // first: a bad scene is reported there too
     try {
+      Param(pnh, "result_file", &result_file_);
       scene_ = LoadScene(nh);
       std::string transport;
       const ExchangeTiming timing = LoadExchangeTiming(pnh, &transport);
-      pnh.param<std::string>("world_frame", world_frame_, "odom");
-      pnh.param<std::string>("map_frame", map_frame_, "map");
-      pnh.param<std::string>("base_frame", base_frame_, "base_link");
+      Param(pnh, "world_frame", &world_frame_);
+      Param(pnh, "map_frame", &map_frame_);
+      Param(pnh, "base_frame", &base_frame_);
       double log_rate = 100.0, clock_rate = 100.0;
-      pnh.param("log_rate", log_rate, log_rate);
-      pnh.param("clock_rate", clock_rate, clock_rate);
-      pnh.param("max_real_time_factor", max_rtf_, 0.0);
-      pnh.param("wait_for_recorder", wait_for_recorder_, true);
-      pnh.param("shutdown_when_done", shutdown_when_done_, false);
-      pnh.param("force_scale", force_scale_, 1e-4);
+      RateParam(pnh, "log_rate", &log_rate, "every step");
+      RateParam(pnh, "clock_rate", &clock_rate);
+      Param(pnh, "max_real_time_factor", &max_rtf_);
+      Param(pnh, "wait_for_recorder", &wait_for_recorder_);
+      Param(pnh, "shutdown_when_done", &shutdown_when_done_);
+      Param(pnh, "force_scale", &force_scale_);
       auto check = [&pnh](bool ok, const std::string& name, const std::string& what) {
         if (!ok) throw ConfigError("parameter " + pnh.resolveName(name) + ": " + what);
       };
-      check(log_rate >= 0.0, "log_rate", "must be >= 0 Hz (0: every step)");
-      check(clock_rate > 0.0, "clock_rate", "must be > 0 Hz");
-      check(max_rtf_ >= 0.0, "max_real_time_factor", "must be >= 0 (0: as fast as possible)");
+      check(max_rtf_ >= 0.0 && std::isfinite(max_rtf_), "max_real_time_factor", "must be >= 0 (0: as fast as possible)");
       check(force_scale_ > 0.0 && std::isfinite(force_scale_), "force_scale", "must be a positive length per force [m/N]");
       log_rate_ = log_rate;
       clock_rate_ = clock_rate;
@@ -213,7 +212,9 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       const double dt = sim_->dt();
       log_every_ = log_rate_ > 0.0 ? std::max(1L, std::lround(1.0 / (log_rate_ * dt))) : 1;
       clock_every_ = std::max(1L, std::lround(1.0 / (clock_rate_ * dt)));
-      driver_->stamp_offset = scene_.settle_time;
+      // the driver's start: the first step after the settling steps (settle_time / dt rounded),
+      // so that a command's stamp is the time of the step it was computed at
+      driver_->stamp_offset = sim_->settle_steps() * dt;
       // the coupling in use: with a terrain of its own step (a DEM soil) and time_step auto, the
       // vehicle steps that fit in one terrain step times the scene's coupling_interval
       NODELET_INFO("time step %.4g s (critical %.4g s: %s), coupling every %d step(s) (%.4g s; scene's "
@@ -439,7 +440,7 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   std::unique_ptr<VehicleCoSim> sim_;
   std::unique_ptr<ExchangeTerrainPort> terrain_;
   std::unique_ptr<ExchangeDriverPort> driver_;
-  std::string world_frame_, map_frame_, base_frame_, result_file_;
+  std::string world_frame_ = "odom", map_frame_ = "map", base_frame_ = "base_link", result_file_;
   std::string interrupted_why_;  ///< why a run was interrupted before it began (the exchange's reason)
   RecorderWatch recorder_;  ///< the bag recorder's failure ends the run with its error
   double log_rate_ = 100.0, clock_rate_ = 100.0, max_rtf_ = 0.0, force_scale_ = 1e-4;

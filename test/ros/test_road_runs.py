@@ -203,6 +203,17 @@ class Failures(unittest.TestCase):
         self.assertEqual(r['status'], 'error')
         self.assertIn('road_slope.yaml: grade_deg', r['error'])
 
+    def test_a_parameter_of_the_wrong_type_is_refused_naming_it(self):
+        # roslaunch gives `fast` as a string: the vehicle refuses it instead of logging at 100 Hz
+        # without a word (ros's NodeHandle::param would take its default)
+        run = Run(self.tmp, 'bad_rate', 'log_rate:=fast').wait(60)
+        r = run.result()
+        self.assertEqual(r['status'], 'error')
+        self.assertIn('parameter /mobility/vehicle/log_rate is not a number', r['error'])
+        run = Run(self.tmp, 'tiny_rate', 'log_rate:=1e-300').wait(60)  # (a string to roslaunch: no '.')
+        self.assertIn('parameter /mobility/vehicle/log_rate: ', run.result()['error'])
+        self.assertIn('a rate is from 1e-6 to 1e9 Hz (0: every step)', run.result()['error'])
+
 
 if __name__ == '__main__':
     unittest.main(verbosity=2)

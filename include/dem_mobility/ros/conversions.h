@@ -40,4 +40,27 @@ YamlReader LoadSceneFile(const ros::NodeHandle& nh);
 /// `peer_timeout` [s], `startup_timeout` [s].
 ExchangeTiming LoadExchangeTiming(const ros::NodeHandle& pnh, std::string* transport);
 
+inline const char* ParamTypeName(const std::string&) { return "a string"; }
+inline const char* ParamTypeName(const double&) { return "a number"; }
+inline const char* ParamTypeName(const int&) { return "an integer"; }
+inline const char* ParamTypeName(const bool&) { return "true or false"; }
+/// A number given as a string (roslaunch makes `1e-4`, without a '.', a string): parsed whole.
+bool NumberFromString(const ros::NodeHandle& nh, const std::string& name, double* value);
+template <class T>
+bool NumberFromString(const ros::NodeHandle&, const std::string&, T*) {
+  return false;
+}
+/// The parameter `name` of `nh` into *value, which keeps its default when the parameter is not
+/// set; ConfigError naming the parameter when it is set but not of the type asked for (ros's
+/// NodeHandle::param would take the default without a word: `wait_for_recorder:=yes`).
+template <class T>
+void Param(const ros::NodeHandle& nh, const std::string& name, T* value) {
+  if (!nh.hasParam(name)) return;
+  if (!nh.getParam(name, *value) && !NumberFromString(nh, name, value))
+    throw ConfigError("parameter " + nh.resolveName(name) + " is not " + ParamTypeName(*value));
+}
+/// A rate parameter [Hz of simulated time] as Param, then checked: finite, at least 1e-6 Hz (a
+/// period a step count can hold) and at most 1e9 Hz, or 0 where `zero` says what 0 means.
+void RateParam(const ros::NodeHandle& nh, const std::string& name, double* value, const char* zero = nullptr);
+
 }  // namespace dem_mobility
