@@ -84,26 +84,27 @@ class SoilRigNodelet : public nodelet::Nodelet {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
     while (wait_for_recorder_ && !stop_ && ros::ok() &&
            (cloud_.getNumSubscribers() == 0 || tools_.getNumSubscribers() == 0 || !topics_->Subscribed())) {
-      if (std::chrono::steady_clock::now() > deadline) {
-        NODELET_WARN("soil rig: no recorder after 60 s; running without");
-        return;
-      }
+      if (std::chrono::steady_clock::now() > deadline)  // as the vehicle: no run without its bag
+        throw ConfigError("no recorder subscribed to the rig's topics within 60 s (set ~wait_for_recorder false to "
+                          "run without one)");
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }
 
   void Run() {
-    WaitForRecorder();
     const DemSystem& s = rig_->dem();
     const double dt = s.dt();
     const long cloud_every = std::max(1L, std::lround(1.0 / (cloud_rate_ * dt)));
     const long clock_every = std::max(1L, std::lround(1.0 / (clock_rate_ * dt)));
-    const auto wall0 = std::chrono::steady_clock::now();
+    auto wall0 = std::chrono::steady_clock::now();
     auto next_progress = wall0 + std::chrono::seconds(10);
     // any error of the run (a numerical failure, a display that cannot be built, memory) ends it
     // with that error in the result: an exception out of this thread would end the whole manager
     // without a result or a closed bag
     try {
+      WaitForRecorder();
+      wall0 = std::chrono::steady_clock::now();  // (the run's wall time from here)
+      next_progress = wall0 + std::chrono::seconds(10);
       PublishContainer();
       PublishFrame();
       while (!rig_->done()) {
