@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
@@ -139,9 +140,14 @@ void Flatten(const XmlRpc::XmlRpcValue& v, const std::string& prefix, std::vecto
       if (!s.empty()) out->push_back(prefix + "=" + s);
       break;
     }
-    case XmlRpc::XmlRpcValue::TypeDouble:
-      out->push_back(prefix + "=" + detail::Concat(static_cast<double>(const_cast<XmlRpc::XmlRpcValue&>(v))));
+    case XmlRpc::XmlRpcValue::TypeDouble: {
+      // every digit (17 significant): the override is the number given, not a rounded one
+      std::ostringstream text;
+      text.precision(17);
+      text << static_cast<double>(const_cast<XmlRpc::XmlRpcValue&>(v));
+      out->push_back(prefix + "=" + text.str());
       break;
+    }
     case XmlRpc::XmlRpcValue::TypeInt:
       out->push_back(prefix + "=" + std::to_string(static_cast<int>(const_cast<XmlRpc::XmlRpcValue&>(v))));
       break;
