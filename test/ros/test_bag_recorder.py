@@ -9,6 +9,7 @@ latch keeps every message, repeated bytes too; the bag closes when the end topic
 """
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -56,16 +57,22 @@ class BagRecorder(unittest.TestCase):
         self.procs = []
 
     def tearDown(self):
+        # each process in a session of its own: a roslaunch that did not end takes its master
+        # and nodes down with it
         for p in self.procs:
             if p.poll() is None:
-                p.kill()
-                p.wait()
+                os.killpg(p.pid, signal.SIGINT)
+                try:
+                    p.wait(20)
+                except subprocess.TimeoutExpired:
+                    os.killpg(p.pid, signal.SIGKILL)
+                    p.wait()
         if os.environ.get("DM_KEEP_TEST_RUNS") is None:
             shutil.rmtree(self.tmp, ignore_errors=True)
 
     def start(self, args, name):
         log = open(os.path.join(self.tmp, name + '.log'), 'w')
-        p = subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, env=self.env)
+        p = subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, env=self.env, start_new_session=True)
         log.close()
         self.procs.append(p)
         return p
