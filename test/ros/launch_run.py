@@ -17,6 +17,19 @@ def free_port():
         return s.getsockname()[1]
 
 
+def stop_group(proc, timeout=20):
+    """Ends a process started in a session of its own together with its children (a roslaunch
+    with its master and nodes): SIGINT, as Ctrl-C, then SIGKILL after `timeout` s."""
+    if proc.poll() is not None:
+        return
+    os.killpg(proc.pid, signal.SIGINT)
+    try:
+        proc.wait(timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+
+
 class LaunchRun:
     """`roslaunch dem_mobility LAUNCH bag:=DIR/run.bag ARGS...` in DIR = tmp/name; the run's result
     YAML is the bag's name with .result.yaml. `env` adds to the environment; `prefix` goes before

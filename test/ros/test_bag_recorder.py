@@ -9,7 +9,6 @@ latch keeps every message, repeated bytes too; the bag closes when the end topic
 """
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
@@ -18,7 +17,7 @@ import unittest
 
 import rosbag
 
-from launch_run import free_port  # beside this file
+from launch_run import free_port, stop_group  # beside this file
 
 PUBLISHER = r'''
 import time
@@ -60,14 +59,8 @@ class BagRecorder(unittest.TestCase):
         # each process in a session of its own: a roslaunch that did not end takes its master
         # and nodes down with it
         for p in self.procs:
-            if p.poll() is None:
-                os.killpg(p.pid, signal.SIGINT)
-                try:
-                    p.wait(20)
-                except subprocess.TimeoutExpired:
-                    os.killpg(p.pid, signal.SIGKILL)
-                    p.wait()
-        if os.environ.get("DM_KEEP_TEST_RUNS") is None:
+            stop_group(p)
+        if os.environ.get('DM_KEEP_TEST_RUNS') is None:
             shutil.rmtree(self.tmp, ignore_errors=True)
 
     def start(self, args, name):

@@ -17,7 +17,7 @@ import unittest
 
 import numpy as np
 
-from launch_run import free_port  # beside this file
+from launch_run import free_port, stop_group  # beside this file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -43,14 +43,7 @@ class MapPublisher(unittest.TestCase):
         return p
 
     def stop(self, p):
-        import signal
-        if p.poll() is None:
-            os.killpg(p.pid, signal.SIGINT)
-            try:
-                p.wait(20)
-            except subprocess.TimeoutExpired:
-                os.killpg(p.pid, signal.SIGKILL)
-                p.wait()
+        stop_group(p)
 
     def test_publishes_the_grid_map_server_would_read(self):
         # 3 rows x 4 columns (north up) of 20 m cells; top speed 20 m/s
