@@ -2,6 +2,7 @@
 
     doe plan  --elevation DEM.tif [--ci CI.tif | --ci-seed N] --level tiny
     doe run   --out DIR [--grades ... --cone-indices ...] --level tiny --jobs 2 [--backend slurm] [--resume] [--dry-run]
+              [--refine N]
     doe status --out DIR
     doe nrmm  --out DIR [--grades ... --cone-indices ...]
     doe map   --table TABLE.yaml --elevation DEM.tif [--ci CI.tif | --ci-seed N] --out DIR [--compare OTHER.yaml]
@@ -352,11 +353,83 @@ def cmd_plan(a):
 
 # -- run, status, case ------------------------------------------------------------------------
 
+def run_pending(a, doc):
+    """The plan's cases not done yet, on the pool or as a Slurm job array: True if interrupted
+    (Ctrl-C), None if submitted without waiting (--no-wait)."""
+    active, lines = slurm.reconcile(a.out, doc)
+    for line in lines:
+        print(line)
+    if active:
+        raise UsageError('%s: %d tasks of its Slurm jobs are still pending or running: wait (doe status), or scancel '
+                         'them, before --resume' % (a.out, active))
+    states = runner.scan(a.out, doc)
+    for k, (s, r) in states.items():
+        if s == 'running':
+            raise UsageError('case %s is running (runs/%s.running): another doe run on %s?' % (
+                doc['cases'][k]['name'], doc['cases'][k]['name'], a.out))
+    failed = [c for c in doc['cases'] if states[c['index']][0] == 'failed']
+    todo = [c for c in doc['cases'] if states[c['index']][0] in ('pending', 'interrupted') or (a.retry_failed and c in failed)]
+    for c in failed:
+        if not a.retry_failed:
+            print('failed before: %s: %s (--retry-failed runs it again)' % (
+                c['name'], (states[c['index']][1] or {}).get('error') or 'no result'))
+    print('doe: %d cases: %d done, %d to run (%d at a time, runner %s)' % (
+        len(doc['cases']), len(doc['cases']) - len(todo) - (0 if a.retry_failed else len(failed)), len(todo), a.jobs,
+        a.runner))
+    interrupted = False
+    if todo and a.backend == 'slurm':
+        indices = [c['index'] for c in todo]
+        job = slurm.submit(a.out, doc, indices, a.jobs, a.partition, a.timeout)
+        print('doe: submitted job array %s: %d tasks, at most %d at once (states: doe status --out %s)' % (
+            job, len(indices), a.jobs, a.out), flush=True)
+        if a.no_wait:
+            return None
+        try:
+            tasks, source = slurm.wait(a.out, doc, job, indices, a.jobs)
+            lost = slurm.record_lost_tasks(a.out, doc, indices, tasks)
+            counts = {}
+            for v in tasks.values():
+                counts[v] = counts.get(v, 0) + 1
+            print('doe: job %s: %s (from %s)%s' % (job, ', '.join('%d %s' % (n, k) for k, n in sorted(counts.items())),
+                                                   source, '; %d tasks ended without a result' % len(lost) if lost else ''))
+        except KeyboardInterrupt:
+            interrupted = True
+    elif todo:
+        by_index = {c['index']: c for c in doc['cases']}
+        cases = dm_sweep.cases([{'index': c['index']} for c in todo], name=lambda p: by_index[p['index']]['name'])
+
+        def describe(o):
+            if not o.ok:
+                return 'FAILED: %s' % o.error
+            r = o.result
+            if r.get('status') == runner.IMPLIED:
+                return 'implied %s by %s' % (r['implied_status'], r['implied_by'])
+            return '%s %.3f m/s' % (r.get('status'), float(r.get('speed_made_good') or 0.0))
+        command = [sys.executable, DOE_SCRIPT, 'case', '--out', os.path.abspath(a.out), '--index', '{index}',
+                   '--port', '{port}']
+        sweep = dm_sweep.Sweep(
+            cases, command, os.path.join(a.out, 'workers'), jobs=a.jobs, port=a.port, timeout=a.timeout,
+            check=lambda case, r: runner.verdict(by_index[case['index']], r), accept_status=(runner.IMPLIED,),
+            result_of=lambda case: runner.result_path(a.out, by_index[case['index']]),
+            weight=lambda case: by_index[case['index']]['estimated_cost'], describe=describe,
+            progress=a.progress, status_every=None, clear_result=False)
+        try:
+            sweep.run()
+        except KeyboardInterrupt:
+            interrupted = True
+        for o in sweep.outcomes:
+            if o.timed_out:
+                runner.record_failure(a.out, doc, by_index[o.case['index']], o.error)
+    return interrupted
+
+
 def cmd_run(a):
     if a.jobs < 1:
         raise UsageError('--jobs %d: at least 1' % a.jobs)
     if a.dem_threads < 1:
         raise UsageError('--dem-threads %d: at least 1' % a.dem_threads)
+    if a.refine < 0:
+        raise UsageError('--refine %d: the number of refinement lines is 0 or more' % a.refine)
     if a.duration is not None and not 0 < a.duration <= 40.0:
         raise UsageError('--duration %g: the driving time is in (0, 40] s (the paper\'s run is 40 s)' % a.duration)
     grid, costs, prior, limits = design(a)
@@ -394,76 +467,31 @@ def cmd_run(a):
     os.makedirs(runner.runs_dir(a.out), exist_ok=True)
     if not os.path.exists(path):
         runner.write_yaml(path, doc)
-    active, lines = slurm.reconcile(a.out, doc)
-    for line in lines:
-        print(line)
-    if active:
-        raise UsageError('%s: %d tasks of its Slurm jobs are still pending or running: wait (doe status), or scancel '
-                         'them, before --resume' % (a.out, active))
+    interrupted = run_pending(a, doc)
+    if interrupted is None:
+        return 0
     states = runner.scan(a.out, doc)
-    for k, (s, r) in states.items():
-        if s == 'running':
-            raise UsageError('case %s is running (runs/%s.running): another doe run on %s?' % (
-                doc['cases'][k]['name'], doc['cases'][k]['name'], a.out))
-    failed = [c for c in doc['cases'] if states[c['index']][0] == 'failed']
-    todo = [c for c in doc['cases'] if states[c['index']][0] in ('pending', 'interrupted') or (a.retry_failed and c in failed)]
-    for c in failed:
-        if not a.retry_failed:
-            print('failed before: %s: %s (--retry-failed runs it again)' % (
-                c['name'], (states[c['index']][1] or {}).get('error') or 'no result'))
-    print('doe: %d cases: %d done, %d to run (%d at a time, runner %s)' % (
-        len(doc['cases']), len(doc['cases']) - len(todo) - (0 if a.retry_failed else len(failed)), len(todo), a.jobs,
-        a.runner))
-    interrupted = False
-    if todo and a.backend == 'slurm':
-        indices = [c['index'] for c in todo]
-        job = slurm.submit(a.out, doc, indices, a.jobs, a.partition, a.timeout)
-        print('doe: submitted job array %s: %d tasks, at most %d at once (states: doe status --out %s)' % (
-            job, len(indices), a.jobs, a.out), flush=True)
-        if a.no_wait:
-            return 0
-        try:
-            tasks, source = slurm.wait(a.out, doc, job, indices, a.jobs)
-            lost = slurm.record_lost_tasks(a.out, doc, indices, tasks)
-            counts = {}
-            for v in tasks.values():
-                counts[v] = counts.get(v, 0) + 1
-            print('doe: job %s: %s (from %s)%s' % (job, ', '.join('%d %s' % (n, k) for k, n in sorted(counts.items())),
-                                                   source, '; %d tasks ended without a result' % len(lost) if lost else ''))
-        except KeyboardInterrupt:
-            interrupted = True
-    elif todo:
-        by_index = {c['index']: c for c in doc['cases']}
-        cases = dm_sweep.cases([{'index': c['index']} for c in todo], name=lambda p: by_index[p['index']]['name'])
-
-        def describe(o):
-            if not o.ok:
-                return 'FAILED: %s' % o.error
-            r = o.result
-            if r.get('status') == runner.IMPLIED:
-                return 'implied %s by %s' % (r['implied_status'], r['implied_by'])
-            return '%s %.3f m/s' % (r.get('status'), float(r.get('speed_made_good') or 0.0))
-        command = [sys.executable, DOE_SCRIPT, 'case', '--out', os.path.abspath(a.out), '--index', '{index}',
-                   '--port', '{port}']
-        sweep = dm_sweep.Sweep(
-            cases, command, os.path.join(a.out, 'workers'), jobs=a.jobs, port=a.port, timeout=a.timeout,
-            check=lambda case, r: runner.verdict(by_index[case['index']], r), accept_status=(runner.IMPLIED,),
-            result_of=lambda case: runner.result_path(a.out, by_index[case['index']]),
-            weight=lambda case: by_index[case['index']]['estimated_cost'], describe=describe,
-            progress=a.progress, status_every=None, clear_result=False)
-        try:
-            sweep.run()
-        except KeyboardInterrupt:
-            interrupted = True
-        for o in sweep.outcomes:
-            if o.timed_out:
-                runner.record_failure(a.out, doc, by_index[o.case['index']], o.error)
+    unfinished = [c['name'] for c in doc['cases'] if states[c['index']][0] not in ('simulated', 'implied')]
+    if a.refine > len(doc.get('refinements') or []) and unfinished and not interrupted:
+        print('doe: --refine waits for a finished grid (%d cases are not done: %s)' % (
+            len(unfinished), ', '.join(unfinished[:5])))
+    elif a.refine and not interrupted:
+        v = nrmm.Vehicle.load(NRMM_VEHICLE)
+        doc, picks = runner.refine_plan(a.out, doc, a.refine,
+                                        lambda g, c: run_cost(costs, a.level, v.speed(g, c)['status'], c))
+        for axis, value, between, jump in picks:
+            print('doe: refinement: %s %g between %g and %g (the speed changes by up to %.2f m/s across them)' % (
+                'grade' if axis == 'grade' else 'cone index', value, between[0], between[1], jump))
+        if picks:
+            interrupted = run_pending(a, doc)
+            if interrupted is None:
+                return 0
     states = runner.scan(a.out, doc)
     rows = runner.table_rows(a.out, doc, states)
     table, summary = runner.write_doe_table(a.out, doc, rows)
     speed = np.array([[np.nan if v is None else v for v in row] for row in summary['speed']], dtype=float)
-    speed_plots(a.out, 'doe', grid, speed, 'speed-made-good, level %s (%d simulated, %d implied)' % (
-        a.level, summary['simulated'], summary['implied']))
+    speed_plots(a.out, 'doe', plan.Grid(doc['grades'], doc['cone_indices']), speed,
+                'speed-made-good, level %s (%d simulated, %d implied)' % (a.level, summary['simulated'], summary['implied']))
     print(runner.status_text(a.out, doc, states, a.jobs))
     print('doe: table %s; %d of %d runs saved by pruning' % (table, summary['implied'], summary['cases']))
     if interrupted:
@@ -547,6 +575,9 @@ def parser():
     p.add_argument('--road-scene', help='a scene file of kind road_slope for the CI 300 cases, instead of '
                    'config/scenes/road_slope.yaml')
     p.add_argument('--no-prune', action='store_true', help='run every case (no implied cases)')
+    p.add_argument('--refine', type=int, default=0, metavar='N',
+                   help='once the grid is finished, add grid lines (N in all) where the speed changes fastest '
+                        'between neighbours, at the midpoints, and run their cases (default 0)')
     p.add_argument('--resume', action='store_true', help='go on with the DOE in --out: finished cases are kept')
     p.add_argument('--retry-failed', action='store_true', help='with --resume: run the failed cases again')
     p.add_argument('--dry-run', action='store_true', help='print the plan and its estimated cost, run nothing')

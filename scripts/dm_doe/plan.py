@@ -13,6 +13,12 @@ the middles of the halves ...: the bisection order of each axis), so that a stuc
 coarse case fixes the finer cases around it before they come up. The order is fixed (it does not
 depend on the outcomes), so that a job array submitted at once (Slurm) runs the same cases in the
 same order as the local pool; a case is checked against the finished ones when its turn comes.
+
+Refinement (doe run --refine N, beyond the paper): once the grid is finished, N new grid lines
+go where the speed changes fastest between neighbouring cases, each at the midpoint of the pair
+of neighbouring grades (or soil cone indices) across which the speed jumps most; their cases run
+like the others (pruned where the finished ones fix them), and the table keeps a full grid, so
+that the map's bilinear interpolation stays what it is.
 """
 import math
 
@@ -131,3 +137,26 @@ def replay(grid, outcome_of):
         else:
             imp.append((cell,) + x)
     return sim, imp
+
+
+def refinements(grades, cone_indices, speed, count, min_grade_step=1.0, min_ci_step=5.0,
+                road_ci=ROAD_CONE_INDEX):
+    """Up to `count` new grid lines where speed-made-good changes fastest between neighbours:
+    [(axis 'grade' or 'cone_index', value, (lo, hi), jump)], the largest jump first. A pair of
+    neighbouring grades (cone indices) is split at its midpoint; its jump is the largest |speed
+    difference| across it over the other axis. A pair whose halves would be narrower than the
+    minimum step (1 deg, 5 psi) is not split, nor the pair between the strongest soil and the
+    road's column (CI road_ci: a rigid road, no soil between them)."""
+    g, c = list(grades), list(cone_indices)
+    candidates = []
+    for i in range(len(g) - 1):
+        if g[i + 1] - g[i] >= 2.0 * min_grade_step:
+            jump = max(abs(speed[i + 1][j] - speed[i][j]) for j in range(len(c)))
+            candidates.append((jump, 'grade', 0.5 * (g[i] + g[i + 1]), (g[i], g[i + 1])))
+    for j in range(len(c) - 1):
+        if c[j + 1] >= road_ci or c[j + 1] - c[j] < 2.0 * min_ci_step:
+            continue
+        jump = max(abs(speed[i][j + 1] - speed[i][j]) for i in range(len(g)))
+        candidates.append((jump, 'cone_index', 0.5 * (c[j] + c[j + 1]), (c[j], c[j + 1])))
+    candidates.sort(key=lambda x: (-x[0], x[1], x[2]))
+    return [(axis, value, between, jump) for jump, axis, value, between in candidates[:max(0, count)] if jump > 0.0]

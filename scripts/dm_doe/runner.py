@@ -100,12 +100,57 @@ def make_plan(grid, level, runner, dem_threads, duration, prune, cost_of, proven
     return doc
 
 
+def designed(doc):
+    """The plan as asked, before any refinement: the grid the user gave and the options."""
+    d = dict(doc)
+    d.update(doc.get('design') or {})
+    return d
+
+
 def same_design(a, b):
-    """None if two plans ask for the same runs, else what differs."""
+    """None if two plans ask for the same runs (the grid as asked, before refinements), else what
+    differs."""
+    a, b = designed(a), designed(b)
     for k in ('grades', 'cone_indices', 'level', 'runner', 'dem_threads', 'duration', 'prune', 'scenes'):
         if (a.get(k) or None) != (b.get(k) or None):
             return '%s: %r in the folder, %r asked' % (k, a.get(k), b.get(k))
     return None
+
+
+def refine_plan(out, doc, total, cost_of):
+    """`doe run --refine N`: the plan with refinement lines added until it holds `total` (none
+    if it has them already): dm_doe.plan.refinements of the finished table, the cases of the
+    new lines pending, the finished ones kept (their files go by name). Every case must be done
+    (simulated or implied). The Slurm jobs so far are set aside (their task indices are the old
+    plan's). Returns (the new plan, the lines added), the plan written."""
+    done = doc.get('refinements') or []
+    if total <= len(done):
+        return doc, []
+    states = scan(out, doc)
+    open_cases = [c['name'] for c in doc['cases'] if states[c['index']][0] not in ('simulated', 'implied')]
+    if open_cases:
+        raise RunnerError('--refine: the grid is not finished (%s): refinement goes by the finished table'
+                          % ', '.join(open_cases[:5]))
+    speed = {(r['grade_deg'], r['cone_index']): r['speed_made_good'] for r in table_rows(out, doc, states)}
+    g, c = doc['grades'], doc['cone_indices']
+    matrix = [[speed[(x, y)] for y in c] for x in g]
+    picks = plan.refinements(g, c, matrix, total - len(done))
+    if not picks:
+        return doc, []
+    grades = sorted(g + [v for axis, v, _, _ in picks if axis == 'grade'])
+    cis = sorted(c + [v for axis, v, _, _ in picks if axis == 'cone_index'])
+    own = ('grades', 'cone_indices', 'level', 'runner', 'dem_threads', 'duration', 'prune', 'scenes', 'commit',
+           'created', 'cases', 'design', 'refinements')
+    new = make_plan(plan.Grid(grades, cis), doc['level'], doc['runner'], doc['dem_threads'], doc['duration'],
+                    doc['prune'], cost_of, {k: v for k, v in doc.items() if k not in own}, doc.get('scenes'))
+    new['design'] = doc.get('design') or {'grades': g, 'cone_indices': c}
+    new['refinements'] = done + [{'axis': axis, 'value': v, 'between': list(between), 'jump': round(float(jump), 4),
+                                  'made': utc_now()} for axis, v, between, jump in picks]
+    jobs = os.path.join(out, 'slurm', 'jobs.yaml')
+    if os.path.exists(jobs):
+        os.replace(jobs, os.path.join(out, 'slurm', 'jobs_before_refinement_%d.yaml' % len(new['refinements'])))
+    write_yaml(os.path.join(out, PLAN_FILE), new)
+    return new, picks
 
 
 def write_yaml(path, doc):

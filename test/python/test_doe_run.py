@@ -187,6 +187,76 @@ class CaseSignals(unittest.TestCase):
         self.assertIn('stopped (signal 15)', r['error'])
 
 
+# a stand-in for dm_run_scene whose speed-made-good is a known function of the grade: steady at
+# 20 - 0.05 g^2 m/s (20, 15 and 0 m/s at 0, 10 and 20 deg), so where the speed changes fastest is known
+STEADY_STAND_IN = r'''
+import sys
+g = float(next(a for a in sys.argv if a.startswith('grade_deg=')).split('=')[1])
+out = sys.argv[sys.argv.index('--out') + 1]
+with open(out, 'w') as fh:
+    fh.write('kind: road_slope\nstatus: steady\nerror: ""\ngrade_deg: %r\nspeed_made_good: %r\n' % (g, 20.0 - 0.05 * g * g))
+'''
+
+
+class Refinement(unittest.TestCase):
+    """doe run --refine N: grid lines where the speed changes fastest between neighbours."""
+
+    def test_the_largest_jumps_are_split_at_their_midpoints(self):
+        grades, cis = [0.0, 10.0, 20.0], [30.0, 50.0, 100.0, 300.0]
+        speed = [[10.0, 12.0, 14.0, 25.0],
+                 [6.0, 11.0, 13.0, 25.0],
+                 [0.0, 3.0, 12.0, 24.0]]
+        # the largest |difference| across each pair: grades 0-10: 4 (at 30 psi), 10-20: 8 (at 50
+        # psi); CIs 30-50: 5 (at 10 deg), 50-100: 9 (at 20 deg); 100-300 is the road's
+        picks = plan.refinements(grades, cis, speed, 3)
+        self.assertEqual([(p[0], p[1], p[2]) for p in picks],
+                         [('cone_index', 75.0, (50.0, 100.0)), ('grade', 15.0, (10.0, 20.0)),
+                          ('cone_index', 40.0, (30.0, 50.0))])
+        self.assertEqual([p[3] for p in picks], [9.0, 8.0, 5.0])
+        # the road's column is not split towards the soil (100 -> 300 jumps by 12); nor a pair
+        # whose halves would be under the minimum step
+        self.assertNotIn(200.0, [p[1] for p in plan.refinements(grades, cis, speed, 10)])
+        self.assertEqual(plan.refinements([0.0, 1.5], [50.0], [[5.0], [1.0]], 1), [])
+        self.assertEqual(plan.refinements([0.0, 2.0], [50.0, 58.0], [[5.0, 6.0], [1.0, 9.0]], 2),
+                         [('grade', 1.0, (0.0, 2.0), 4.0)])
+
+    def test_a_refined_doe_runs_the_new_line_keeps_the_rest_and_resumes(self):
+        tmp = tempfile.mkdtemp(prefix='dm_doe_refine_')
+        self.addCleanup(shutil.rmtree, tmp, True)
+        exe = os.path.join(tmp, 'stand_in')
+        with open(exe, 'w') as fh:
+            fh.write('#!/bin/sh\nexec %s -c "$STAND_IN_CODE" "$@"\n' % sys.executable)
+        os.chmod(exe, 0o755)
+        env = {'DM_RUN_SCENE': exe, 'STAND_IN_CODE': STEADY_STAND_IN}
+        out = os.path.join(tmp, 'doe')
+        grid = ['--grades', '0,10,20', '--cone-indices', '300', '--runner', 'core', '--progress', 'plain']
+        rc, so, se = doe('run', '--out', out, '--refine', '1', *grid, env=env)
+        self.assertEqual(rc, 0, so + se)
+        self.assertIn('refinement: grade 15 between 10 and 20 (the speed changes by up to 15.00 m/s', so)
+        t = load(os.path.join(out, 'doe_table.yaml'))
+        self.assertEqual(t['grades'], [0.0, 10.0, 15.0, 20.0])
+        self.assertEqual([row[0] for row in t['speed']], [20.0, 15.0, 8.75, 0.0])
+        self.assertEqual((t['simulated'], t['implied'], t['failed']), (4, 0, 0))
+        p = runner.load_plan(out)
+        self.assertEqual(p['design']['grades'], [0.0, 10.0, 20.0])
+        self.assertEqual([(r['axis'], r['value'], r['between']) for r in p['refinements']], [('grade', 15.0, [10.0, 20.0])])
+        # the cases run before were not run again (one log line each), the new one once
+        with open(os.path.join(out, 'runs', 'g0_ci300.log')) as fh:
+            self.assertEqual(fh.read().count('$ '), 1)
+        # resume with the same grid: nothing to run, no new line; --refine 2 adds the next
+        rc, so, se = doe('run', '--out', out, '--resume', '--refine', '1', *grid, env=env)
+        self.assertEqual(rc, 0, so + se)
+        self.assertIn('4 cases: 4 done, 0 to run', so)
+        self.assertNotIn('refinement:', so)
+        rc, so, se = doe('run', '--out', out, '--resume', '--refine', '2', *grid, env=env)
+        self.assertEqual(rc, 0, so + se)
+        self.assertIn('refinement: grade 17.5 between 15 and 20', so)  # 8.75 m/s there: the largest now
+        self.assertEqual(load(os.path.join(out, 'doe_table.yaml'))['grades'], [0.0, 10.0, 15.0, 17.5, 20.0])
+        rc, _, se = doe('run', '--out', out, '--refine', '-1', '--resume', *grid, env=env)
+        self.assertEqual(rc, 2)
+        self.assertIn('--refine -1', se)
+
+
 class RoadDoe(unittest.TestCase):
     """A 3 x 1 DOE on the rigid road (grades 0, 1, 2 deg, CI 300): the plan runs 0 and 2 deg first
     (the axis's ends); 2 deg reaches the 25 m/s command, which bounds 1 deg from below: implied."""
