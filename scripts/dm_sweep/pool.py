@@ -268,6 +268,24 @@ class Sweep:
                 pass
             o.proc.wait()
 
+    def _reap_group(self, o, grace=2.0):
+        """Whatever is left of a run's process group once its leader has ended (a roslaunch
+        killed with SIGKILL leaves its master and nodes): SIGTERM, then SIGKILL after `grace` s."""
+        if o.proc is None or o.proc.poll() is None:
+            return
+        for sig in (signal.SIGTERM, signal.SIGKILL):
+            try:
+                os.killpg(o.proc.pid, sig)
+            except (ProcessLookupError, PermissionError):
+                return  # the group is gone
+            deadline = time.time() + grace
+            while time.time() < deadline:
+                try:
+                    os.killpg(o.proc.pid, 0)
+                except (ProcessLookupError, PermissionError):
+                    return
+                time.sleep(0.05)
+
     def _finish(self, o):
         o.end = time.time()
         if o.logf is not None:
@@ -321,8 +339,8 @@ class Sweep:
                 while pending and len(running) < self.jobs:
                     o = pending.pop(0)
                     o.slot, o.port = self._take_port(ports, {r.port for r in running})
+                    running.append(o)  # before it starts: a signal inside _launch must find it
                     self._launch(o)
-                    running.append(o)
                     self.line('[%6.0f s] start  %-14s (port %d)' % (time.time() - self.t0, o.name, o.port))
                 time.sleep(self.poll)
                 for o in list(running):
@@ -333,6 +351,7 @@ class Sweep:
                     if alive and late:
                         o.timed_out = True
                         self._kill(o)
+                    self._reap_group(o)
                     self._finish(o)
                     running.remove(o)
                     ports.append(o.slot)
@@ -351,13 +370,24 @@ class Sweep:
                     last_status = time.time()
                     for o in running:
                         self.line('           ...    %-14s %s' % (o.name, last_progress(o.log, self.progress_marker)))
-        except KeyboardInterrupt:
-            for o in running:
-                self._kill(o, wait=False)
-            for o in running:
-                self._kill(o)
-                self._finish(o)
-                o.error = 'interrupted'
+        except BaseException as e:
+            # Ctrl-C, SIGTERM, or any error of the sweep itself (a callback, a file it cannot
+            # write): the running runs are stopped and finished before it goes on, so that none is
+            # left computing with nothing watching it; a second signal meanwhile waits
+            main = threading.current_thread() is threading.main_thread()
+            if main:
+                blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+            try:
+                for o in running:
+                    self._kill(o, wait=False)
+                for o in running:
+                    self._kill(o)
+                    self._reap_group(o)
+                    self._finish(o)
+                    o.error = 'interrupted' if isinstance(e, KeyboardInterrupt) else 'the sweep stopped: %r' % e
+            finally:
+                if main:
+                    signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
             raise
         finally:
             self._progress.close()

@@ -35,6 +35,11 @@ if mode == 'killed_once':  # killed mid-case (SIGKILL, no clean-up) the first ti
     if not os.path.exists(flag):
         open(flag, 'w').close()
         os.kill(os.getpid(), 9)
+if mode == 'orphan':  # killed (SIGKILL) leaving a child of its own behind, as a killed roslaunch leaves its nodes
+    import subprocess
+    child = subprocess.Popen(['sleep', '60'])
+    open(journal + '.' + name + '.pid', 'w').write(str(child.pid))
+    os.kill(os.getpid(), 9)
 if mode == 'hang':
     import subprocess
     child = subprocess.Popen(['sleep', '60'])
@@ -201,6 +206,34 @@ class Pool(Base):
         starts = self.starts()  # (two at a time: the first three in any order)
         self.assertEqual(sorted(starts[:3]), ['modekilled-once_x2', 'modeok_x1', 'modeok_x3'])
         self.assertEqual(starts[3:], ['modekilled-once_x2'])
+
+    def test_an_error_of_the_sweep_itself_stops_its_runs_before_it_goes_on(self):
+        # a callback that raises (here describe, once the first case is done) while another case
+        # runs: the error goes on to the caller, and the running case and its child are stopped
+        # first, its error naming why, instead of being left computing with nothing watching
+        cases = dm_sweep.cases([{'mode': 'ok', 'x': 1, 'sleep': 1.0}, {'mode': 'hang', 'x': 2}])
+
+        def describe(o):
+            raise RuntimeError('a callback failed')
+        s = self.sweep(cases, describe=describe)
+        with self.assertRaises(RuntimeError):
+            s.run()
+        by = {o.case['x']: o for o in s.outcomes}
+        self.assertTrue(by[2].error.startswith('the sweep stopped: RuntimeError'), by[2].error)
+        with open(self.journal + '.modehang_x2.pid') as fh:
+            child = int(fh.read())
+        time.sleep(0.2)
+        self.assertFalse(os.path.exists('/proc/%d' % child) and 'Z' not in _proc_state(child))
+
+    def test_what_a_killed_run_leaves_in_its_group_is_stopped(self):
+        cases = dm_sweep.cases([{'mode': 'orphan', 'x': 1}])
+        s = self.sweep(cases)
+        s.run()
+        self.assertEqual(s.outcomes[0].returncode, -9)
+        with open(self.journal + '.modeorphan_x1.pid') as fh:
+            child = int(fh.read())
+        time.sleep(0.2)
+        self.assertFalse(os.path.exists('/proc/%d' % child) and 'Z' not in _proc_state(child), 'the child was left')
 
     def test_sigterm_stops_the_sweep_and_its_runs_within_a_second(self):
         # a sweep in a process of its own, SIGTERM once its second (hanging) case has started: the
