@@ -21,7 +21,6 @@ own ROS master), and writes into OUT:
 A failed run is reported and the others are kept; the exit status is 1 if any run failed.
 """
 import argparse
-import hashlib
 import math
 import os
 import shutil
@@ -34,7 +33,7 @@ import yaml
 # dm_sweep lives beside this script (also when run through catkin's relay in devel/lib)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import dm_sweep  # noqa: E402
-from dm_sweep.args import floats, git_commit, ints  # noqa: E402
+from dm_sweep.args import floats, git_commit, ints, keep_options, number, sha256  # noqa: E402
 
 PAPER_TABLE = [(30, 0.06), (40, 0.15), (50, 0.5), (60, 0.84), (70, 1.18), (80, 1.52), (100, 2.24),
                (120, 3.03), (150, 4.46), (200, 7.85), (242, 12.1)]
@@ -91,13 +90,6 @@ def mean_points(runs):
     return out
 
 
-def sha256(path):
-    h = hashlib.sha256()
-    with open(path, 'rb') as fh:
-        for block in iter(lambda: fh.read(1 << 16), b''):
-            h.update(block)
-    return h.hexdigest()
-
 
 def scene_level(scene, fidelity):
     """The soil file and the level's conditions from the scene file."""
@@ -113,18 +105,33 @@ def scene_level(scene, fidelity):
     return soil, float(level['particle_diameter']), {k: level[k] for k in keys if k in level}
 
 
-def error_vs_finest(finest, table, fidelity, mu, d):
-    """The table's relative CI error against the finest level's runs (a YAML file: level, friction,
-    particle_diameter, points {f, ci}, source), at the f values inside the table; without one, a
-    note that no finer level was run."""
+def load_finest(path):
+    """The finest level's runs for --finest (a YAML file: level, friction, particle_diameter,
+    points {f, ci}, source), read and checked before any run; ValueError naming what is wrong."""
+    with open(path) as fh:
+        ref = yaml.safe_load(fh)
+    try:
+        ref['friction'] = float(ref['friction'])
+        fs, cis = [float(v) for v in ref['points']['f']], [float(v) for v in ref['points']['ci']]
+        str(ref['level'])
+    except (TypeError, KeyError, ValueError) as e:
+        raise ValueError('%s: not a finest-level file (level, friction, points.f, points.ci): %s' % (path, e))
+    if len(fs) != len(cis) or not fs:
+        raise ValueError('%s: points.f and points.ci must be lists of the same, non-zero length' % path)
+    ref['points'] = {'f': fs, 'ci': cis}
+    return ref
+
+
+def error_vs_finest(finest, ref, table, fidelity, mu):
+    """The table's relative CI error against the finest level's runs (ref: load_finest(finest)), at
+    the f values inside the table; without one, or one at another friction, a note that says so."""
     if not finest:
         return {'level': fidelity, 'note': 'only this level (%s) was run for this table: its error against a finer '
                                            'level is not known' % fidelity}
-    with open(finest) as fh:
-        ref = yaml.safe_load(fh)
-    if abs(float(ref['friction']) - mu) > 1e-9:
-        raise ValueError('%s: friction %g, not the table\'s %g' % (finest, ref['friction'], mu))
-    fs, cis = [float(v) for v in ref['points']['f']], [float(v) for v in ref['points']['ci']]
+    if abs(ref['friction'] - mu) > 1e-9:
+        return {'level': fidelity, 'note': 'the finest level\'s runs (%s) are at friction %g, not this table\'s %g: '
+                                           'not compared' % (os.path.basename(finest), ref['friction'], mu)}
+    fs, cis = ref['points']['f'], ref['points']['ci']
     tf, tci = [r[1] for r in table], [r[0] for r in table]
     rel = []
     for f, ci in zip(fs, cis):
@@ -275,8 +282,17 @@ def main():
         sys.exit('calibrate_cone_index: --seeds must list distinct seeds >= 0')
     if not os.path.isfile(a.scene):
         sys.exit('calibrate_cone_index: no scene file %s' % a.scene)
-    if a.finest and not os.path.isfile(a.finest):
-        sys.exit('calibrate_cone_index: no file %s (--finest)' % a.finest)
+    if len(set(a.f)) < 2 or not a.mu:
+        sys.exit('calibrate_cone_index: --f needs two cohesion factors at least (a table is a fit) and --mu one '
+                 'friction at least')
+    finest_ref = None
+    if a.finest:
+        try:
+            finest_ref = load_finest(a.finest)
+        except OSError as e:
+            sys.exit('calibrate_cone_index: --finest %s: %s' % (a.finest, e.strerror))
+        except (ValueError, yaml.YAMLError) as e:
+            sys.exit('calibrate_cone_index: --finest: %s' % e)
     # the commit and the files' hashes as the runs start (a checkout changed during the sweep
     # does not change what ran)
     root = os.path.dirname(here)
@@ -302,9 +318,9 @@ def main():
 
     def command(case, run):
         return ['roslaunch', '-p', str(run.port), 'dem_mobility', 'cone_penetrometer.launch',
-                'scene:=' + os.path.abspath(a.scene), 'fidelity:=' + a.fidelity, 'f:=%g' % case['f'],
-                'mu:=%g' % case['mu'], 'seed:=%d' % case['seed'], 'dem_threads:=%d' % a.dem_threads,
-                'bag:=' + os.path.abspath(bag_path(a.out, case.name)), 'cloud_rate:=%g' % a.cloud_rate]
+                'scene:=' + os.path.abspath(a.scene), 'fidelity:=' + a.fidelity, 'f:=' + number(case['f']),
+                'mu:=' + number(case['mu']), 'seed:=%d' % case['seed'], 'dem_threads:=%d' % a.dem_threads,
+                'bag:=' + os.path.abspath(bag_path(a.out, case.name)), 'cloud_rate:=' + number(a.cloud_rate)]
 
     def check(case, result):
         return None if result.get('window_samples') else 'no CI sample in the window'
@@ -320,6 +336,12 @@ def main():
         except TypeError:
             return False
 
+    # the scene, its level and soil as the runs are made with them: a resume with others is refused
+    try:
+        keep_options(a.out, {'--scene': os.path.abspath(a.scene), 'scene_sha256': scene_sha, 'soil_sha256': soil_sha,
+                             '--fidelity': a.fidelity, 'conditions': conditions}, a.resume)
+    except ValueError as e:
+        sys.exit('calibrate_cone_index: %s' % e)
     sweep = dm_sweep.Sweep(cases, command, os.path.join(a.out, 'runs'), jobs=a.jobs, port=a.port,
                            timeout=a.timeout, check=check, outputs=lambda case: [bag_path(a.out, case.name)],
                            describe=describe, poll=1.0, status_every=20.0)
@@ -351,10 +373,7 @@ def main():
         if any(n > 1 for _, _, _, n in points):
             pts['ci_std'] = [round(sd, 3) if sd is not None else 0.0 for _, _, sd, _ in points]
         pts['seeds'] = [n for _, _, _, n in points]
-        try:
-            err = error_vs_finest(a.finest, table, a.fidelity, mu, diameter)
-        except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as e:
-            sys.exit('calibrate_cone_index: --finest: %s' % e)
+        err = error_vs_finest(a.finest, finest_ref, table, a.fidelity, mu)
         doc = {
             'particle_diameter': diameter,
             'friction': mu,
@@ -420,7 +439,11 @@ def main():
                                   'error': r.error, 'bag': r.bag} for r in runs]}, fh, sort_keys=False)
     print('sweep: %d runs in %.0f s, %d failed%s' % (len(runs), time.time() - t0, len(failed),
                                                     ''.join('\n  failed: %s: %s' % (r.name, r.error) for r in failed)))
-    sys.exit(1 if failed else 0)
+    no_table = [mu for mu in a.mu if mu not in fits]
+    if no_table:
+        print('calibrate_cone_index: no table for mu %s (fewer than two f values with a good run)'
+              % ', '.join('%g' % mu for mu in no_table), file=sys.stderr)
+    sys.exit(1 if failed or no_table else 0)
 
 
 if __name__ == '__main__':

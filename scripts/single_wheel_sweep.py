@@ -40,7 +40,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import dm_sweep  # noqa: E402
 from dm_sweep import wheel_numerics as wn  # noqa: E402
-from dm_sweep.args import floats  # noqa: E402
+from dm_sweep.args import floats, keep_options, number as num, sha256  # noqa: E402
 from dm_sweep.wheel_plots import plots, soil_label  # noqa: E402,F401
 
 ROOT = os.path.dirname(HERE)
@@ -87,13 +87,13 @@ def roslaunch_command(a, case, port):
     """The roslaunch command of a case (the arguments of single_wheel.launch)."""
     argv = ['roslaunch', '-p', str(port), 'dem_mobility', 'single_wheel.launch',
             'scene:=' + os.path.abspath(a.scene), 'fidelity:=' + a.fidelity]
-    argv.append(('cone_index:=%g' if case['soil_key'] == 'ci' else 'f:=%g') % case['soil'])
+    argv.append(('cone_index:=' if case['soil_key'] == 'ci' else 'f:=') + num(case['soil']))
     if case['drive'] == 'slip':
-        argv.append('slip:=%g' % case['slip'])
+        argv.append('slip:=' + num(case['slip']))
     argv += ['drive:=' + case['drive'], 'dem_threads:=%d' % a.dem_threads]
     for arg, v in (('mu', a.mu), ('load', a.load), ('speed', a.speed)):
         if v is not None:
-            argv.append('%s:=%g' % (arg, v))
+            argv.append('%s:=%s' % (arg, num(v)))
     if a.seed is not None:
         argv.append('seed:=%d' % a.seed)
     argv += ['bag:=' + os.path.abspath(bag_path(a.out, case.name)), 'cloud_rate:=%g' % a.cloud_rate,
@@ -104,13 +104,13 @@ def roslaunch_command(a, case, port):
 def core_command(a, case, result_file):
     """dm_run_scene's command of a case (--runner core, a developer's check)."""
     argv = [a.dm_run_scene, os.path.abspath(a.scene), 'fidelity=' + a.fidelity, 'threads=%d' % a.dem_threads]
-    argv.append(('cone_index=%g' if case['soil_key'] == 'ci' else 'cohesion_factor=%g') % case['soil'])
+    argv.append(('cone_index=' if case['soil_key'] == 'ci' else 'cohesion_factor=') + num(case['soil']))
     argv.append('wheel.drive=' + case['drive'])
     if case['drive'] == 'slip':
-        argv.append('wheel.slip=%g' % case['slip'])
+        argv.append('wheel.slip=' + num(case['slip']))
     for key, v in (('friction', a.mu), ('wheel.load_mass', a.load), ('wheel.speed', a.speed)):
         if v is not None:
-            argv.append('%s=%g' % (key, v))
+            argv.append('%s=%s' % (key, num(v)))
     if a.seed is not None:
         argv.append('seed=%d' % a.seed)
     return argv + ['--out', os.path.abspath(result_file)]
@@ -436,6 +436,14 @@ def main(argv=None):
     if a.runner == 'core':
         print('runner: core (%s): a developer check, NOT the launch files users run; no bags' % a.dm_run_scene,
               flush=True)
+    # what the runs depend on and their results do not all hold (the seed, and the scene's values
+    # of mu, load and speed where not given): a resume with other options is refused
+    try:
+        keep_options(a.out, {'--scene': os.path.abspath(a.scene), 'scene_sha256': sha256(a.scene),
+                             '--fidelity': a.fidelity, '--seed': a.seed, '--mu': a.mu, '--load': a.load,
+                             '--speed': a.speed, '--runner': a.runner}, a.resume)
+    except ValueError as e:
+        sys.exit('%s: %s' % (PROG, e))
     if a.resume:
         sweep.resume(accept=same_run(a))
     t0 = time.time()

@@ -29,6 +29,7 @@ import yaml
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import dm_sweep  # noqa: E402
+from dm_sweep.args import keep_options  # noqa: E402
 
 ROOT = os.path.dirname(HERE)
 # particle diameter of each level (config/terrains/soil_patch.yaml), finest first
@@ -87,24 +88,14 @@ def same_run(a):
     return accept
 
 
-OPTIONS_FILE = 'study_options.yaml'
-
-
 def check_options(a, out):
-    """The options a result depends on and no result file holds (the driving time, the runner),
-    kept in OUT; --resume with others is refused naming the option."""
-    now = {'scene': os.path.abspath(a.scene), 'duration': a.duration, 'runner': a.runner}
-    path = os.path.join(out, OPTIONS_FILE)
-    if a.resume and os.path.exists(path):
-        with open(path) as fh:
-            old = yaml.safe_load(fh) or {}
-        for key, v in now.items():
-            if old.get(key) != v:
-                raise SystemExit('soil_fidelity_study.py: --resume: %s holds runs made with --%s %s, not %s'
-                                 % (out, key.replace('_', '-'), old.get(key), v))
-    os.makedirs(out, exist_ok=True)
-    with open(path, 'w') as fh:
-        yaml.safe_dump(now, fh, sort_keys=False)
+    """The options a result depends on and no result file holds (the driving time, the runner, the
+    scene), kept in OUT; --resume with others is refused naming the option."""
+    try:
+        keep_options(out, {'--scene': os.path.abspath(a.scene), '--duration': a.duration, '--runner': a.runner},
+                     a.resume)
+    except ValueError as e:
+        raise SystemExit('soil_fidelity_study.py: %s' % e)
 
 
 def number(x):

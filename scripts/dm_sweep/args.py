@@ -1,7 +1,14 @@
-"""Small helpers the sweep scripts share: comma-separated number lists for argparse, and the
-checkout's commit for a result's provenance."""
+"""Small helpers the sweep scripts share: comma-separated number lists for argparse, the
+checkout's commit for a result's provenance, and the options a sweep's results depend on kept
+in its folder (so that a resume with others is refused)."""
 import argparse
+import hashlib
+import os
 import subprocess
+
+import yaml
+
+OPTIONS_FILE = 'sweep_options.yaml'
 
 
 def floats(text):
@@ -30,3 +37,38 @@ def git_commit(root):
         return head + ('-dirty' if dirty else '')
     except (OSError, subprocess.CalledProcessError):
         return 'unknown (not a git checkout)'
+
+
+def number(x):
+    """A number for a command line with every digit kept: the shortest form that reads back as the
+    same float ('%g' would run 1234.567 as 1234.57), a whole number without '.0'."""
+    text = repr(float(x))
+    return text[:-2] if text.endswith('.0') else text
+
+
+def sha256(path):
+    """The sha256 of a file's bytes (hex)."""
+    h = hashlib.sha256()
+    with open(path, 'rb') as fh:
+        for block in iter(lambda: fh.read(1 << 16), b''):
+            h.update(block)
+    return h.hexdigest()
+
+
+def keep_options(out, options, resume):
+    """The options a sweep's results depend on and no result file holds (a driving time, a seed,
+    a scene file and its hash, ...), written to OUT/sweep_options.yaml; with `resume`, ValueError
+    naming the first option whose value differs from the one the folder's runs were made with
+    (an option the folder's file does not name, written by an older version, is not compared)."""
+    path = os.path.join(out, OPTIONS_FILE)
+    if resume and os.path.exists(path):
+        with open(path) as fh:
+            old = yaml.safe_load(fh) or {}
+        for key, value in options.items():
+            if key in old and old[key] != value:
+                raise ValueError('--resume: %s holds runs made with %s %s, not %s' % (out, key, old[key], value))
+    os.makedirs(out, exist_ok=True)
+    tmp = path + '.tmp%d' % os.getpid()
+    with open(tmp, 'w') as fh:
+        yaml.safe_dump(dict(options), fh, sort_keys=False)
+    os.replace(tmp, path)

@@ -199,6 +199,39 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         self.assertNotIn('relative', err)
         self.assertIn('only this level', err['note'])
 
+    def test_bad_input_is_refused_before_any_run(self):
+        bad = os.path.join(self.tmp, 'bad_finest.yaml')
+        with open(bad, 'w') as fh:
+            yaml.safe_dump({'level': 'medium', 'friction': 0.1}, fh)   # no points
+        for args, what in ((['--f', '1,2', '--finest', bad], 'not a finest-level file'),
+                           (['--f', '1'], '--f needs two cohesion factors'),
+                           (['--f', '1,2', '--finest', os.path.join(self.tmp, 'none.yaml')], 'No such file')):
+            out = os.path.join(self.tmp, 'refused_%d' % len(what))
+            r = subprocess.run(
+                [sys.executable, os.path.join(ROOT, 'scripts', 'calibrate_cone_index.py'), '--fidelity', 'tiny',
+                 '--mu', '0.1', '--port', '11711', '--out', out] + args, stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT, universal_newlines=True, env=self.env, timeout=60)
+            self.assertNotEqual(r.returncode, 0, r.stdout)
+            self.assertIn(what, r.stdout)
+            self.assertFalse(os.path.exists(os.path.join(out, 'runs', 'calls')), 'a run was made: ' + what)
+
+    def test_a_finest_file_at_another_friction_is_not_compared_and_both_tables_are_written(self):
+        out = os.path.join(self.tmp, 'two_mu')
+        r = self.sweep('0.5,3', '--mu', '0.1,0.05', '--finest', self.finest, out=out)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        d = self.tiny['particle_diameter']
+        with open(os.path.join(out, 'cone_index_mu0.05_d%g.yaml' % d)) as fh:
+            self.assertIn('not compared', yaml.safe_load(fh)['error_vs_finest']['note'])
+        with open(os.path.join(out, 'cone_index_mu0.1_d%g.yaml' % d)) as fh:
+            self.assertIn('relative', yaml.safe_load(fh)['error_vs_finest'])
+
+    def test_a_resume_at_another_level_is_refused_naming_it(self):
+        # (the runs' own results would let a kept run through the f, mu and seed checks: the
+        # level's conditions and the scene's and soil's files are kept in the folder)
+        r = self.sweep('0.5,8', '--resume', '--fidelity', 'test')
+        self.assertNotEqual(r.returncode, 0, r.stdout)
+        self.assertIn('--resume: %s holds runs made with --fidelity tiny, not test' % self.out, r.stdout)
+
 
 if __name__ == '__main__':
     unittest.main()

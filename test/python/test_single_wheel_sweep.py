@@ -363,6 +363,14 @@ class SweepWithoutRos(unittest.TestCase):
         self.assertEqual(rows['ci100_slip0.1']['wall_time'], 1.5)  # the kept run's own wall time
         self.assertFalse(rows['ci100_slip0.5']['kept'])
 
+    def test_a_resume_with_another_seed_or_load_is_refused_naming_it(self):
+        # the results hold neither the seed nor the scene's load where none was given: the
+        # folder keeps the options its runs were made with
+        for more, what in ((['--seed', '7'], '--seed None, not 7'), (['--load', '800'], '--load None, not 800.0')):
+            r = self.sweep('0.1', '--resume', *more)
+            self.assertNotEqual(r.returncode, 0, r.stdout)
+            self.assertIn('--resume: %s holds runs made with %s' % (self.out, what), r.stdout)
+
 
 def bag_of(call):
     """The bag's file name in a recorded roslaunch call."""
