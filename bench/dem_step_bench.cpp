@@ -95,7 +95,7 @@ void Report(const char* bed, const DemSystem& s, int steps) {
   DemSystem warm = s;
   for (int i = 0; i < 20; ++i) warm.Step();
   const DemContactSummary c = warm.ContactSummary();
-  std::printf("dem_step %s_pair_kernel %s name\n", bed, PairKernelName(PairKernel::kAuto));
+  std::printf("# dem_step %s: pair kernel %s\n", bed, PairKernelName(PairKernel::kAuto));
   std::printf("dem_step %s_contacts_per_particle %.2f count\n", bed, 2.0 * c.contacts / s.num_alive());
   std::printf("dem_step %s_mean_normal_force %.4g N\n", bed, c.mean_normal);
   std::printf("dem_step %s_mean_adhesion %.4g N\n", bed, c.mean_adhesion);
@@ -111,7 +111,8 @@ void Report(const char* bed, const DemSystem& s, int steps) {
   std::printf("dem_step %s_rate_1thread %.3f Mparticle-steps/s\n", bed, v1.rate * 1e-6);
   std::printf("dem_step %s_rate_2threads %.3f Mparticle-steps/s\n", bed, v2.rate * 1e-6);
   std::printf("dem_step %s_speedup_1_to_2 %.3f x\n", bed, v2.rate / v1.rate);
-  std::printf("dem_step %s_rebuilds %ld count (in %d timed steps)\n", bed, v2.rebuilds, steps);
+  std::printf("# dem_step %s_rebuilds: the neighbour-list builds of the %d timed steps\n", bed, steps);
+  std::printf("dem_step %s_rebuilds %ld count\n", bed, v2.rebuilds);
   if (scalar) {
     std::printf("dem_step %s_scalar_rate_1thread %.3f Mparticle-steps/s\n", bed, s1.rate * 1e-6);
     std::printf("dem_step %s_scalar_rate_2threads %.3f Mparticle-steps/s\n", bed, s2.rate * 1e-6);
@@ -133,7 +134,7 @@ int main(int argc, char** argv) {
       const double r = PairLawThroughput(k, SoilContactLaw(soil), soil.diameter, 1.5e-5, 2000000);
       std::printf("dem_step law_only_%s %.1f Mpairs/s\n", PairKernelName(k), r * 1e-6);
     } catch (const ConfigError&) {
-      std::printf("dem_step law_only_%d not on this CPU\n", static_cast<int>(k));
+      std::printf("# dem_step law_only_%d: not on this CPU\n", static_cast<int>(k));
     }
   const DemSystem bed_a = ReferenceBed(soil);
   std::printf("dem_step bed_particles %d count\n", bed_a.num_alive());
@@ -149,7 +150,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::printf("dem_step poured_particles %d count\n", bed->num_alive());
-  std::printf("dem_step poured_preparation %.1f s (%.3f s simulated)\n", prep.wall_time, prep.sim_time);
+  std::printf("dem_step poured_preparation %.1f s\n", prep.wall_time);
+  std::printf("dem_step poured_preparation_simulated %.3f s\n", prep.sim_time);
   std::printf("dem_step poured_density %.0f kg/m^3\n", prep.density_consolidated);
   Report("poured", *bed, steps);
   return 0;

@@ -131,11 +131,14 @@ int main(int argc, char** argv) {
           const double r = bare_wall / coupled;  // (n soil_steps / coupled) / (n soil_steps / bare)
           const std::string tag = done == 0 ? "_before_following" : "";
           const char *lv = level.c_str(), *tg = tag.c_str();
-          std::printf("soil_scene %s_window%s %.4f s_simulated (t = %.3f-%.3f s, speed %.2f m/s, %ld soil steps)\n", lv, tg,
-                      sim_time, t_begin, s.time(), s.vehicle().ForwardSpeed(), soil_steps);
+          std::printf("# soil_scene %s_window%s: t = %.3f-%.3f s, speed %.2f m/s, %ld soil steps\n", lv, tg, t_begin,
+                      s.time(), s.vehicle().ForwardSpeed(), soil_steps);
+          std::printf("soil_scene %s_window%s %.4f s\n", lv, tg, sim_time);
           std::printf("soil_scene %s_reemitted%s %ld count\n", lv, tg, reemitted);
-          std::printf("soil_scene %s_rebuilds%s %ld neighbour %ld wall (bare soil: %ld, %ld) count\n", lv, tg, nb, wb,
-                      bare.neighbour_builds() - bnb0, bare.wall_builds() - bwb0);
+          std::printf("soil_scene %s_neighbour_rebuilds%s %ld count\n", lv, tg, nb);
+          std::printf("soil_scene %s_wall_rebuilds%s %ld count\n", lv, tg, wb);
+          std::printf("soil_scene %s_bare_soil_neighbour_rebuilds%s %ld count\n", lv, tg, bare.neighbour_builds() - bnb0);
+          std::printf("soil_scene %s_bare_soil_wall_rebuilds%s %ld count\n", lv, tg, bare.wall_builds() - bwb0);
           std::printf("soil_scene %s_coupled_rate%s %.3f Mparticle-steps/s\n", lv, tg, 1e-6 * n * soil_steps / coupled);
           std::printf("soil_scene %s_bare_soil_rate%s %.3f Mparticle-steps/s\n", lv, tg, 1e-6 * n * soil_steps / bare_wall);
           std::printf("soil_scene %s_rate_ratio%s %.3f ratio\n", lv, tg, r);

@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
   }
   const double setup = Seconds(t0);
   const int n = rig.dem().num_alive();
-  std::printf("wheel_soil level %s -\n", p.bin.level.name.c_str());
+  std::printf("# wheel_soil level %s\n", p.bin.level.name.c_str());
   std::printf("wheel_soil particles %d count\n", n);
   std::printf("wheel_soil tire_triangles %zu count\n", p.tire.soil_mesh.faces.size());
   std::printf("wheel_soil setup_wall %.1f s\n", setup);

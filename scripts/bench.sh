@@ -21,6 +21,15 @@ if [ "$want" = doe_map ]; then ensure_packages "${DM_MAP_PACKAGES[@]}"; fi
 if [ "$want" != vehicle_step ] && [ "$want" != dem_step ] && [ "$want" != wheel_soil ] && [ "$want" != soil_scene ] &&
    [ "$want" != doe_map ]; then build_catkin >/dev/null; ros_env; fi
 echo "# $(date -u +%Y-%m-%dT%H:%MZ) $(uname -m) $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
+# one benchmark line, NAME FIGURE VALUE UNIT; a value that is not a number (a figure that was not
+# measured: a log without the line it is read from, a failed computation) ends the run with an error
+figure() {
+  if [[ ! "$3" =~ ^[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?$ ]]; then
+    echo "bench: $1 $2: no measured value (got '$3')" >&2
+    exit 1
+  fi
+  echo "$1 $2 $3 $4"
+}
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 
@@ -42,8 +51,8 @@ if [ "$want" = all ] || [ "$want" = cosim_exchange ]; then
     label="$1"; shift
     roslaunch dem_mobility cosim_exchange.launch label:="$label" out:="$tmp/$label.yaml" "$@" >"$tmp/$label.log" 2>&1 || true
     if [ -f "$tmp/$label.yaml" ]; then
-      echo "cosim_exchange ${label}_median $(yaml_get "$tmp/$label.yaml" median_us) us"
-      echo "cosim_exchange ${label}_p99 $(yaml_get "$tmp/$label.yaml" p99_us) us"
+      figure cosim_exchange ${label}_median "$(yaml_get "$tmp/$label.yaml" median_us)" us
+      figure cosim_exchange ${label}_p99 "$(yaml_get "$tmp/$label.yaml" p99_us)" us
     else
       echo "cosim_exchange $label failed; log:" >&2; tail -20 "$tmp/$label.log" >&2; exit 1
     fi
@@ -61,12 +70,12 @@ if [ "$want" = all ] || [ "$want" = road_scene ]; then
     if [ ! -f "$r" ] || [ "$(yaml_get "$r" status)" = error ]; then
       echo "road_scene $1 failed; log:" >&2; tail -20 "$tmp/$1.log" >&2; exit 1
     fi
-    echo "road_scene ${1}_time_step $(yaml_get "$r" time_step) s"
-    echo "road_scene ${1}_simulated $(python3 -c "import yaml,sys; d=yaml.safe_load(open(sys.argv[1])); print(round(d['steps']*d['time_step'],3))" "$r") s"
-    echo "road_scene ${1}_wall $(yaml_get "$r" wall_time) s"
-    echo "road_scene ${1}_real_time_factor $(yaml_get "$r" real_time_factor) x"
-    echo "road_scene ${1}_us_per_step $(python3 -c "import yaml,sys; d=yaml.safe_load(open(sys.argv[1])); print(round(1e6*d['wall_time']/d['steps'],2))" "$r") us"
-    echo "road_scene ${1}_bag_size $(du -m "$tmp/$1.bag" | cut -f1) MB"
+    figure road_scene ${1}_time_step "$(yaml_get "$r" time_step)" s
+    figure road_scene ${1}_simulated "$(python3 -c "import yaml,sys; d=yaml.safe_load(open(sys.argv[1])); print(round(d['steps']*d['time_step'],3))" "$r")" s
+    figure road_scene ${1}_wall "$(yaml_get "$r" wall_time)" s
+    figure road_scene ${1}_real_time_factor "$(yaml_get "$r" real_time_factor)" x
+    figure road_scene ${1}_us_per_step "$(python3 -c "import yaml,sys; d=yaml.safe_load(open(sys.argv[1])); print(round(1e6*d['wall_time']/d['steps'],2))" "$r")" us
+    figure road_scene ${1}_bag_size "$(du -m "$tmp/$1.bag" | cut -f1)" MB
   done
 fi
 
@@ -83,25 +92,27 @@ if [ "$want" = all ] || [ "$want" = dem_step ]; then
     (cd "$tmp" && lmp -in bed.in >lmp1.log 2>&1 && mpirun --allow-run-as-root --oversubscribe -np 2 lmp -in bed.in >lmp2.log 2>&1)
     rate() { awk '/Loop time of .* for 1000 steps/ {printf "%.3f", $(NF-1) * 1000 / $4 / 1e6}' "$1"; }
     l1=$(rate "$tmp/lmp1.log"); l2=$(rate "$tmp/lmp2.log")
-    echo "dem_step lammps_rate_1rank $l1 Mparticle-steps/s"
-    echo "dem_step lammps_rate_2ranks $l2 Mparticle-steps/s"
+    figure dem_step lammps_rate_1rank "$l1" Mparticle-steps/s
+    figure dem_step lammps_rate_2ranks "$l2" Mparticle-steps/s
     # the timed run's neighbour builds (the second run's line) and its last thermo line's mean force
-    echo "dem_step lammps_rebuilds $(awk '/Neighbor list builds/ {n = $NF} END {print n}' "$tmp/lmp2.log") count (in 1000 timed steps)"
-    echo "dem_step lammps_mean_normal_force $(awk '$1 == 1200 && NF == 3 {printf "%.4g", $3}' "$tmp/lmp2.log") N"
+    echo "# dem_step lammps_rebuilds: the neighbour-list builds of the 1000 timed steps"
+    figure dem_step lammps_rebuilds "$(awk '/Neighbor list builds/ {n = $NF} END {print n}' "$tmp/lmp2.log")" count
+    figure dem_step lammps_mean_normal_force "$(awk '$1 == 1200 && NF == 3 {printf "%.4g", $3}' "$tmp/lmp2.log")" N
     ours=$(awk '/bed_rate_2threads/ {print $3}' "$tmp/dem.txt")
-    echo "dem_step lammps_ratio_2threads $(python3 -c "print(round($ours / $l2, 3))") ratio"
+    figure dem_step lammps_ratio_2threads "$(python3 -c "print(round($ours / $l2, 3))")" ratio
     # bed (b)'s granular counterpart (bench/lammps-poured-bed.in: the same count, size and box,
     # settled at rest; gran/hooke/history at our k_n), 2 ranks: its timed run is the last 1000 steps
     (cd "$tmp" && mpirun --allow-run-as-root --oversubscribe -np 2 lmp -in "$DM_ROOT/bench/lammps-poured-bed.in" >lmp3.log 2>&1)
     p2=$(rate "$tmp/lmp3.log")
-    echo "dem_step lammps_poured_rate_2ranks $p2 Mparticle-steps/s"
-    echo "dem_step lammps_poured_rebuilds $(awk '/Neighbor list builds/ {n = $NF} END {print n}' "$tmp/lmp3.log") count (in 1000 timed steps)"
+    figure dem_step lammps_poured_rate_2ranks "$p2" Mparticle-steps/s
+    echo "# dem_step lammps_poured_rebuilds: the neighbour-list builds of the 1000 timed steps"
+    figure dem_step lammps_poured_rebuilds "$(awk '/Neighbor list builds/ {n = $NF} END {print n}' "$tmp/lmp3.log")" count
     # the last thermo line of the timed run: step atoms ke coordination mean-normal-force
     read -r _ _ _ p_cn p_mf < <(awk '$1 == 13500 && NF == 5' "$tmp/lmp3.log") || true
-    echo "dem_step lammps_poured_contacts_per_particle $p_cn count"
-    echo "dem_step lammps_poured_mean_normal_force $p_mf N"
+    figure dem_step lammps_poured_contacts_per_particle "$p_cn" count
+    figure dem_step lammps_poured_mean_normal_force "$p_mf" N
     poured=$(awk '/poured_rate_2threads/ {print $3}' "$tmp/dem.txt")
-    [ -n "$poured" ] && echo "dem_step lammps_poured_ratio_2threads $(python3 -c "print(round($poured / $p2, 3))") ratio"
+    figure dem_step lammps_poured_ratio_2threads "$(python3 -c "print(round($poured / $p2, 3))")" ratio
   else
     echo "dem_step: $bed not found; LAMMPS not run" >&2
   fi
