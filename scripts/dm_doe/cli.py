@@ -424,6 +424,9 @@ def run_pending(a, doc):
 
 
 def cmd_run(a):
+    # a runner named relative to here: absolute for the cases (a Slurm task starts in the DOE folder)
+    if os.environ.get('DM_RUN_SCENE'):
+        os.environ['DM_RUN_SCENE'] = os.path.abspath(os.environ['DM_RUN_SCENE'])
     if a.jobs < 1:
         raise UsageError('--jobs %d: at least 1' % a.jobs)
     if a.dem_threads < 1:
