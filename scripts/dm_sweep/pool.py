@@ -203,6 +203,12 @@ class Sweep:
             old, _ = read_result(o.result_file)
             if not isinstance(old, dict) or self.verdict(o.case, old, o.log) is not None:
                 continue
+            # how the run that left it ended: a good result of a run that exited non-zero, timed
+            # out or was stopped is not kept (the result itself is judged again, by this sweep's
+            # checks; no outcome file: a run of an older sweep)
+            ended, _ = read_result(self._outcome_file(o))
+            if isinstance(ended, dict) and not ended.get('ended_well'):
+                continue
             if accept is not None and not accept(o.case, old):
                 continue
             try:
@@ -231,8 +237,24 @@ class Sweep:
                 break
         return slot, port
 
+    def _outcome_file(self, o):
+        """Where a run's end is kept (ok, error, exit status), for a later resume."""
+        return os.path.join(self.runs_dir, o.name + '.outcome.yaml')
+
+    def _record(self, o, stopped=False):
+        """How the run's process ended (not what its result says: a later sweep judges that by its
+        own checks)."""
+        ended_well = o.proc is not None and o.returncode == 0 and not o.timed_out and not stopped
+        try:
+            with open(self._outcome_file(o), 'w') as fh:
+                yaml.safe_dump({'ended_well': ended_well, 'returncode': o.returncode, 'timed_out': bool(o.timed_out),
+                                'stopped': stopped}, fh, sort_keys=False)
+        except OSError:
+            pass  # (the outcome is in the summary too; a resume then judges by the result alone)
+
     def _launch(self, o):
-        for p in (list(self.outputs(o.case)) if self.outputs else []) + ([o.result_file] if self.clear_result else []):
+        for p in ([self._outcome_file(o)] + (list(self.outputs(o.case)) if self.outputs else []) +
+                  ([o.result_file] if self.clear_result else [])):
             if os.path.exists(p):
                 os.remove(p)
         env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % o.port, PYTHONUNBUFFERED='1',
@@ -312,6 +334,7 @@ class Sweep:
             o.error = self.verdict(o.case, result, o.log)
         if not o.error and o.returncode not in (0, None):
             o.error = '%s exited with %d; see %s' % (os.path.basename(o.argv[0]), o.returncode, o.log)
+        self._record(o)
 
     def run(self, t0=None):
         """Runs every case not done yet (not kept by resume), `jobs` at a time, and returns the
@@ -385,6 +408,7 @@ class Sweep:
                     self._reap_group(o)
                     self._finish(o)
                     o.error = 'interrupted' if isinstance(e, KeyboardInterrupt) else 'the sweep stopped: %r' % e
+                    self._record(o, stopped=True)
             finally:
                 if main:
                     signal.pthread_sigmask(signal.SIG_SETMASK, blocked)

@@ -58,6 +58,8 @@ if mode == 'sunk':
     doc.update(status='sunk', error='the wheel sank 0.3 m')
 with open(os.environ['DM_SWEEP_RESULT'], 'w') as fh:
     yaml.safe_dump(doc, fh)
+if mode == 'exit_after_result':  # a good result, then a failing exit
+    sys.exit(5)
 '''
 
 
@@ -256,7 +258,9 @@ class Pool(Base):
         t = time.time()
         p.send_signal(signal.SIGTERM)
         out, _ = p.communicate(timeout=10)
-        self.assertLess(time.time() - t, 2.0)
+        # (well under the 30 s of the kill grace a run that ignored SIGTERM would get: the bound
+        # tells a stop from a wait, with room for a loaded machine)
+        self.assertLess(time.time() - t, 5.0)
         self.assertEqual(p.returncode, 4, out)
         self.assertIn("('modeok_x1', True, None)", out)
         self.assertIn("('modehang_x2', False, 'interrupted')", out)
@@ -387,6 +391,19 @@ class Resume(Base):
         self.assertEqual(rows['modeok_x1']['wall_time'], 0.0)  # the stand-in's wall_time
         self.assertFalse(rows['modeok_x3']['kept'])
         self.assertFalse(rows['modefail_x2']['ok'])
+
+    def test_a_good_result_of_a_run_that_failed_is_not_kept(self):
+        # the run wrote a good result and then exited with 5: failed; a resume runs it again
+        cases = dm_sweep.cases([{'mode': 'ok', 'x': 1}, {'mode': 'exit_after_result', 'x': 2}])
+        first = self.sweep(cases)
+        first.run()
+        by = {o.case['x']: o for o in first.outcomes}
+        self.assertIn('exited with 5', by[2].error)
+        os.remove(self.journal)
+        second = self.sweep(cases)
+        self.assertEqual([o.name for o in second.resume()], ['modeok_x1'])
+        second.run()
+        self.assertEqual(self.starts(), ['modeexit-after-result_x2'])
 
     def test_accept_and_check(self):
         cases = dm_sweep.grid([('x', [1, 2])])
