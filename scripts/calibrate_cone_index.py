@@ -282,6 +282,11 @@ def main():
         sys.exit('calibrate_cone_index: --seeds must list distinct seeds >= 0')
     if not os.path.isfile(a.scene):
         sys.exit('calibrate_cone_index: no scene file %s' % a.scene)
+    stray = [f for f, _ in a.seeds_at if f not in a.f]
+    if stray:
+        sys.exit('calibrate_cone_index: --seeds-at %g: not one of the --f values' % stray[0])
+    if a.install and a.install.endswith(os.sep) and not os.path.isdir(a.install):
+        sys.exit('calibrate_cone_index: --install %s: no such directory' % a.install)
     if len(set(a.f)) < 2 or not a.mu:
         sys.exit('calibrate_cone_index: --f needs two cohesion factors at least (a table is a fit) and --mu one '
                  'friction at least')

@@ -390,6 +390,9 @@ def main(argv=None):
     ap.add_argument('--progress', choices=('auto', 'tqdm', 'plain'), default='auto')
     ap.add_argument('--out', default='results/single_wheel')
     a = ap.parse_args(argv)
+    for opt, v in (('--ci', a.ci), ('--f', a.f)):
+        if v is not None and not v:
+            sys.exit('%s: %s: no value given (leave the option out for the default, CI 100)' % (PROG, opt))
     if not a.ci and not a.f:
         a.ci = [100.0]
     if a.jobs < 1 or a.dem_threads < 1:

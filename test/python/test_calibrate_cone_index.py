@@ -205,7 +205,10 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
             yaml.safe_dump({'level': 'medium', 'friction': 0.1}, fh)   # no points
         for args, what in ((['--f', '1,2', '--finest', bad], 'not a finest-level file'),
                            (['--f', '1'], '--f needs two cohesion factors'),
-                           (['--f', '1,2', '--finest', os.path.join(self.tmp, 'none.yaml')], 'No such file')):
+                           (['--f', '1,2', '--finest', os.path.join(self.tmp, 'none.yaml')], 'No such file'),
+                           (['--f', '1,2', '--seeds-at', '3=1,2'], '--seeds-at 3: not one of the --f values'),
+                           (['--f', '1,2', '--install', os.path.join(self.tmp, 'nowhere') + os.sep],
+                            'nowhere/: no such directory')):
             out = os.path.join(self.tmp, 'refused_%d' % len(what))
             r = subprocess.run(
                 [sys.executable, os.path.join(ROOT, 'scripts', 'calibrate_cone_index.py'), '--fidelity', 'tiny',

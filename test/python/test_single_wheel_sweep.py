@@ -363,6 +363,12 @@ class SweepWithoutRos(unittest.TestCase):
         self.assertEqual(rows['ci100_slip0.1']['wall_time'], 1.5)  # the kept run's own wall time
         self.assertFalse(rows['ci100_slip0.5']['kept'])
 
+    def test_an_empty_soil_list_is_refused(self):
+        # (argparse's floats gives [] for '': that was taken as "not given", CI 100)
+        r = self.sweep('0.1', '--ci', '')
+        self.assertNotEqual(r.returncode, 0, r.stdout)
+        self.assertIn('--ci: no value given', r.stdout)
+
     def test_a_resume_with_another_seed_or_load_is_refused_naming_it(self):
         # the results hold neither the seed nor the scene's load where none was given: the
         # folder keeps the options its runs were made with
