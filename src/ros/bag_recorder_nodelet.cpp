@@ -23,6 +23,8 @@
 #include <std_msgs/String.h>
 #include <topic_tools/shape_shifter.h>
 
+#include "dem_mobility/ros/conversions.h"
+
 namespace dem_mobility {
 namespace {
 
@@ -99,8 +101,7 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     std::vector<std::string> topics, stream, latched;
     std::string end;
     // every parameter checked before the bag is made: a parameter of the wrong type is an error
-    // naming it, never its default
-    auto set_but_not = [&pnh](const char* name, bool got) { return pnh.hasParam(name) && !got; };
+    // naming it, never its default (Param)
     if (!pnh.getParam("bag", path_) || path_.empty()) return Fatal("parameter " + pnh.resolveName("bag") + " is not set");
     if (!pnh.getParam("topics", topics) || topics.empty())
       return Fatal("parameter " + pnh.resolveName("topics") + " (the list of topics to record) is not set");
@@ -108,12 +109,13 @@ class BagRecorderNodelet : public nodelet::Nodelet {
     if (!pnh.getParam("stream_topics", stream) || stream.empty())
       return Fatal("parameter " + pnh.resolveName("stream_topics") +
                    " (the topics published all run long, which order the bag) is not a list of topics");
-    if (set_but_not("latched_topics", pnh.getParam("latched_topics", latched)))
-      return Fatal("parameter " + pnh.resolveName("latched_topics") + " is not a list of topics");
-    if (set_but_not("end_topic", pnh.getParam("end_topic", end)))
-      return Fatal("parameter " + pnh.resolveName("end_topic") + " is not a topic name");
-    if (set_but_not("shutdown_when_done", pnh.getParam("shutdown_when_done", shutdown_when_done_)))
-      return Fatal("parameter " + pnh.resolveName("shutdown_when_done") + " is not true or false");
+    try {
+      Param(pnh, "latched_topics", &latched);
+      Param(pnh, "end_topic", &end);
+      Param(pnh, "shutdown_when_done", &shutdown_when_done_);
+    } catch (const std::exception& e) {
+      return Fatal(e.what());
+    }
     for (const auto& [name, list] : {std::pair<const char*, const std::vector<std::string>*>{"stream_topics", &stream},
                                      {"latched_topics", &latched}})
       for (const std::string& s : *list)

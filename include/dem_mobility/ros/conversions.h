@@ -44,6 +44,7 @@ inline const char* ParamTypeName(const std::string&) { return "a string"; }
 inline const char* ParamTypeName(const double&) { return "a number"; }
 inline const char* ParamTypeName(const int&) { return "an integer"; }
 inline const char* ParamTypeName(const bool&) { return "true or false"; }
+inline const char* ParamTypeName(const std::vector<std::string>&) { return "a list of strings"; }
 /// A number given as a string (roslaunch makes `1e-4`, without a '.', a string): parsed whole.
 bool NumberFromString(const ros::NodeHandle& nh, const std::string& name, double* value);
 template <class T>
