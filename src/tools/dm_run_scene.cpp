@@ -1,6 +1,7 @@
 // Command-line runner of core scenes (no ROS): runs a scene file of any kind and prints its result.
 //
 //   dm_run_scene SCENE.yaml [key=value ...] [--out RESULT.yaml] [--history HISTORY.csv] [--quiet]
+//                [--checkpoint FILE [--checkpoint-every SECONDS]] [--restart FILE]
 //   dm_run_scene SCENE.yaml [key=value ...] --check     read and check everything, run nothing
 //   dm_run_scene --help
 // key=value overrides a scene key (dotted for nested keys: driver.kp=4000, grade_deg=12).
@@ -11,6 +12,8 @@
 // interrupted).
 #include <atomic>
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -28,6 +31,7 @@ extern "C" void OnSignal(int) { g_stop.store(true); }
 
 int Usage(std::ostream& os, int status) {
   os << "usage: dm_run_scene SCENE.yaml [key=value ...] [--out RESULT.yaml] [--history HISTORY.csv] [--quiet]\n"
+        "                   [--checkpoint FILE [--checkpoint-every SECONDS]] [--restart FILE]\n"
         "       dm_run_scene SCENE.yaml [key=value ...] --check\n"
         "       dm_run_scene --help\n"
         "Runs a scene file of any kind (its `scene:` key) without ROS and prints its result.\n"
@@ -35,6 +39,11 @@ int Usage(std::ostream& os, int status) {
         "  --out FILE         writes the result (YAML) there; checked to be writable before the run\n"
         "  --history FILE     mobility runs: the speed history as CSV\n"
         "  --quiet            no progress lines\n"
+        "  --checkpoint FILE  mobility runs: keeps the whole run's state in FILE (written when the run begins\n"
+        "                     to step, every --checkpoint-every wall seconds, default 600, and on SIGINT or\n"
+        "                     SIGTERM; kept after an error or an interrupt, removed once the run has ended)\n"
+        "  --restart FILE     mobility runs: takes the run up from that checkpoint, bit for bit as if it had\n"
+        "                     never stopped; the same scene, overrides, input files and build are required\n"
         "  --check            reads and checks the scene and every file it names (vehicle, terrain, soil,\n"
         "                     calibration table), runs nothing, prepares no soil; exit 0 when all is good\n"
         "exit status: 0 done, 1 bad input (the message names file and key), 2 usage, 3 a numerical failure\n"
@@ -68,6 +77,18 @@ int main(int argc, char** argv) {
     if (a == "--out" && i + 1 < argc) out_file = argv[++i];
     else if (a == "--history" && i + 1 < argc) options.history_file = argv[++i];
     else if (a == "--quiet") options.quiet = true;
+    else if (a == "--checkpoint" && i + 1 < argc) options.checkpoint_file = argv[++i];
+    else if (a == "--restart" && i + 1 < argc) options.restart_file = argv[++i];
+    else if (a == "--checkpoint-every" && i + 1 < argc) {
+      const std::string v = argv[++i];
+      char* end = nullptr;
+      const double s = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !(s >= 1.0 && s <= 1e7)) {
+        std::cerr << "dm_run_scene: --checkpoint-every " << v << ": a number of wall seconds in [1, 1e7]\n";
+        return 2;
+      }
+      options.checkpoint_every = s;
+    }
     else if (a == "--check") check = true;
     else if (a.rfind("__", 0) == 0 && a.find(":=") != std::string::npos) continue;  // roslaunch's __name:=, __log:=
     else if (a.find('=') != std::string::npos && a.rfind("--", 0) != 0) overrides.push_back(a);
@@ -81,9 +102,22 @@ int main(int argc, char** argv) {
       std::cout << scene_file << ": ok (" << kind.scene << ": the scene and the files it names read and checked)\n";
       return 0;
     }
+    const std::string kind = FindSceneKind(reader).scene;
+    if ((!options.checkpoint_file.empty() || !options.restart_file.empty()) && kind != "road_slope" &&
+        kind != "soil_slope")
+      throw ConfigError(scene_file + ": scene " + kind +
+                        ": --checkpoint and --restart are for mobility runs (road_slope, soil_slope)");
     // the results must be writable before the run spends its time on them
     ResultFile::CheckWritable(out_file);
     ResultFile::CheckWritable(options.history_file);
+    if (!options.checkpoint_file.empty()) {
+      // (its temporary file, not the checkpoint itself: that may be the one --restart reads)
+      const std::string probe = options.checkpoint_file + ".writing";
+      ResultFile::CheckWritable(probe, "--checkpoint");
+      std::remove(probe.c_str());
+    }
+    options.scene_file = scene_file;
+    options.overrides = overrides;
     const ResultFile result = FindSceneKind(reader).run(reader, options);
     if (!out_file.empty()) result.Write(out_file);
     if (result.status() == "error") {

@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 #include <functional>
 #include <limits>
 #include <stdexcept>
@@ -14,7 +17,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/input_files.h"
 #include "dem_mobility/core/common/result_file.h"
+#include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/cosim/cosim_loop.h"
 #include "dem_mobility/core/mobility/mobility_scene.h"
@@ -51,6 +56,8 @@ class RecordingTerrain final : public TerrainModel {
   }
   void Advance(double dt) override { calls.push_back("advance " + std::to_string(dt)); }
   const TriMesh& Surface() const override { return mesh_; }
+  void SaveState(StateWriter& out) const override { out(t_, n_); }
+  void LoadState(StateReader& in) override { in(t_, n_); }
   mutable std::vector<std::string> calls;
 
  private:
@@ -296,6 +303,126 @@ TEST(VehicleCoSim, EndsWhenSteadyIfAskedWithTheSpeedOfTheFullRun) {
   EXPECT_TRUE(early.ended_early);
   EXPECT_LT(early.sim_time, 0.9 * full.sim_time);
   EXPECT_NEAR(early.smg.value, full.smg.value, 0.01 * full.smg.value);
+}
+
+/// Stops a run at the start of vehicle step `at`, writing a checkpoint there first.
+struct CheckpointAt final : public CoSimObserver {
+  CheckpointAt(const MobilityRun& run, long at, std::string path, CheckpointIdentity id)
+      : run_(run), at_(at), path_(std::move(path)), id_(std::move(id)) {}
+  void AtStepStart(const VehicleCoSim& sim, const CoSimLoopState& st) override {
+    if (!stop_ && sim.step() == at_) {
+      run_.WriteCheckpoint(path_, id_, st);
+      stop_ = true;
+    }
+  }
+  bool StopRequested() override { return stop_; }
+  const MobilityRun& run_;
+  long at_;
+  std::string path_;
+  CheckpointIdentity id_;
+  bool stop_ = false;
+};
+
+/// Every figure of two histories the same, bit for bit (EXPECT_EQ on doubles: no tolerance).
+void ExpectSameHistory(const std::vector<MobilitySample>& a, const std::vector<MobilitySample>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    SCOPED_TRACE("sample " + std::to_string(i) + " (t = " + std::to_string(a[i].t) + " s)");
+    EXPECT_EQ(a[i].t, b[i].t);
+    EXPECT_EQ(a[i].x, b[i].x);
+    EXPECT_EQ(a[i].speed, b[i].speed);
+    EXPECT_EQ(a[i].drive_torque, b[i].drive_torque);
+    EXPECT_EQ(a[i].brake_effort, b[i].brake_effort);
+    EXPECT_EQ(a[i].traction, b[i].traction);
+    EXPECT_EQ(a[i].y, b[i].y);
+    EXPECT_EQ(a[i].heading, b[i].heading);
+    for (int w = 0; w < kWheels; ++w) {
+      EXPECT_EQ(a[i].slip[w], b[i].slip[w]);
+      EXPECT_EQ(a[i].sinkage[w], b[i].sinkage[w]);
+    }
+    if (::testing::Test::HasFailure()) return;
+  }
+}
+
+TEST(Checkpoint, ARoadRunTakenUpAgainIsTheRunThatNeverStopped) {
+  // a copy of the road scene (its vehicle and terrain by absolute path) that the test may change
+  std::ifstream in(DM_CONFIG_DIR "/scenes/road_slope.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  for (const char* key : {"vehicle: ../", "terrain: ../"}) {
+    const size_t at = text.find(key);
+    ASSERT_NE(at, std::string::npos) << key;
+    text.replace(at, std::string(key).size(), std::string(key).substr(0, 9) + DM_CONFIG_DIR "/");
+  }
+  const std::string scene = WriteTemp("checkpoint_road_scene.yaml", text);
+  const std::string ckpt = ::testing::TempDir() + "checkpoint_road.ckpt";
+  const std::vector<std::string> overrides = {"grade_deg=10", "duration=1.5", "result.end_when_steady=false"};
+  const size_t mark = InputFileCount();
+  const MobilityRunParams p = MobilityRunParams::Read(YamlReader::LoadWithOverrides(scene, overrides));
+
+  MobilityRun whole(p);
+  const MobilityRunResult a = whole.Run();
+  ASSERT_TRUE(a.error.empty()) << a.error;
+  CheckpointIdentity id;
+  id.scene_file = std::filesystem::absolute(scene).lexically_normal().string();
+  id.overrides = overrides;
+  id.files = InputFilesSince(mark);
+  id.executable = ExecutableFingerprint();
+  ASSERT_GE(id.files.size(), 3u);  // the scene, the vehicle's files, the road
+
+  // the same run stopped at a step of the driving (the driver's integral, the tires' anchors and the
+  // history all under way), written there, and taken up again from the file
+  MobilityRun first(p);
+  const long at = first.sim().settle_steps() + (a.steps - first.sim().settle_steps()) / 2 + 7;
+  CheckpointAt stopper(first, at, ckpt, id);
+  const MobilityRunResult b = first.Run(&stopper);
+  ASSERT_TRUE(b.interrupted);
+  ASSERT_LT(b.history.size(), a.history.size());
+  CoSimLoopState loop;
+  CheckpointIdentity read;
+  std::unique_ptr<MobilityRun> rest = MobilityRun::FromCheckpoint(ckpt, p, scene, overrides, &loop, &read);
+  EXPECT_EQ(read.step, at);
+  EXPECT_EQ(rest->sim().step(), at);
+  EXPECT_EQ(rest->dt(), whole.dt());
+  const MobilityRunResult c = rest->Run(nullptr, &loop);
+  ASSERT_TRUE(c.error.empty()) << c.error;
+  EXPECT_FALSE(c.interrupted);
+  EXPECT_EQ(c.steps, a.steps);
+  EXPECT_EQ(c.exchanges, a.exchanges);
+  EXPECT_EQ(c.driver_updates, a.driver_updates);
+  ExpectSameHistory(a.history, c.history);
+  EXPECT_EQ(c.smg.value, a.smg.value);
+  EXPECT_EQ(c.vehicle_energy.dissipated, a.vehicle_energy.dissipated);
+  EXPECT_EQ(c.vehicle_ledger.least, a.vehicle_ledger.least);
+  const Eigen::Vector3d xa = whole.vehicle().ChassisFramePosition(), xc = rest->vehicle().ChassisFramePosition();
+  EXPECT_TRUE((xa.array() == xc.array()).all()) << xa.transpose() << " vs " << xc.transpose();
+  // the wall time goes on from the part before
+  EXPECT_GE(c.wall_time, loop.r.wall_time);
+
+  // what a restart refuses, naming the checkpoint and what differs
+  const auto refused = [&](const std::string& file, const std::vector<std::string>& ovr, const std::string& what) {
+    CoSimLoopState l;
+    try {
+      MobilityRun::FromCheckpoint(file, p, scene, ovr, &l);
+      ADD_FAILURE() << "no error for " << what;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  refused(ckpt, {"grade_deg=12", "duration=1.5", "result.end_when_steady=false"}, "overrides");
+  std::ifstream ck(ckpt, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(ck)), std::istreambuf_iterator<char>());
+  const std::string cut = WriteTemp("checkpoint_cut.ckpt", bytes.substr(0, bytes.size() / 2));
+  refused(cut, overrides, "early");
+  std::string other = bytes;
+  other[0] = 'X';
+  refused(WriteTemp("checkpoint_other.ckpt", other), overrides, "not a dem_mobility checkpoint");
+  refused(::testing::TempDir() + "no_such.ckpt", overrides, "cannot open");
+  // an input file changed since the run began (a comment is a change: the bytes are what count)
+  std::ofstream(scene, std::ios::app) << "# changed\n";
+  refused(ckpt, overrides, "has changed");
 }
 
 }  // namespace

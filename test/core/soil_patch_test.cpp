@@ -17,6 +17,7 @@
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
+#include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/cosim/cosim_loop.h"
 #include "dem_mobility/core/mobility/mobility_scene.h"
@@ -582,6 +583,8 @@ TEST(VehicleOnSoil, RefusesBadInputNamingFileAndKey) {
     void GetWrenches(std::vector<WheelWrench>* w) const override { w->assign(kWheels, WheelWrench()); }
     void Advance(double) override {}
     const TriMesh& Surface() const override { return surface_; }
+    void SaveState(StateWriter&) const override {}  // (nothing changes)
+    void LoadState(StateReader&) override {}
 
    private:
     TerrainDescription d_;

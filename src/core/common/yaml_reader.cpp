@@ -1,4 +1,5 @@
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/common/input_files.h"
 
 #include <cmath>
 #include <filesystem>
@@ -42,7 +43,9 @@ YamlReader YamlReader::Load(const std::string& path) {
   if (!in) throw ConfigError(path + ": cannot open file (missing or unreadable)");
   std::stringstream ss;
   ss << in.rdbuf();
-  return FromString(ss.str(), path);
+  const std::string text = ss.str();
+  NoteInputFile(path, text);  // (what a checkpoint records of the run: common/input_files.h)
+  return FromString(text, path);
 }
 
 YamlReader YamlReader::LoadWithOverrides(const std::string& path, const std::vector<std::string>& overrides) {

@@ -43,9 +43,16 @@ std::string Unstable(const VehicleCoSim& sim, const LedgerWatch& w) {
 
 }  // namespace
 
-MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, DriverPort& driver, CoSimObserver* observer) {
+MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, DriverPort& driver, CoSimObserver* observer,
+                                  const CoSimLoopState* resume) {
   const MobilityRunParams& p = sim.params();
-  MobilityRunResult r;
+  CoSimLoopState st;
+  if (resume) {
+    st = *resume;
+    st.wall_before = resume->r.wall_time;
+  }
+  st.wall0 = std::chrono::steady_clock::now();
+  MobilityRunResult& r = st.r;
   r.dt = sim.dt();
   r.dt_crit = sim.limit().dt_crit;
   r.dt_limit_element = sim.limit().element;
@@ -55,21 +62,31 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
   r.coupling_interval = sim.coupling_interval();
   Vehicle& veh = sim.vehicle();
   const double dt = sim.dt();
-  const auto wall0 = std::chrono::steady_clock::now();
   const long drive_step = sim.settle_steps();
   const long run_steps = std::lround(p.duration / dt);
   const long sample_every = std::max(1L, std::lround(1.0 / (p.sample_rate * dt)));
   const long control_every = std::max(1L, std::lround(p.driver.control_period / dt));
-  // the watchdog's least scale: the vehicle's weight times its tire radius
-  r.vehicle_ledger.floor = veh.system().TotalMass() * 9.81 * veh.tire().radius;
-  DriverCommand cmd;
-  cmd.brake_effort = 1.0;  // settling: brakes on, no drive
-  Eigen::Vector3d p0 = Eigen::Vector3d::Zero();  // the chassis frame at the driver's start
+  DriverCommand& cmd = st.cmd;
+  Eigen::Vector3d& p0 = st.p0;  // the chassis frame at the driver's start
+  if (!resume) {
+    // the watchdog's least scale: the vehicle's weight times its tire radius
+    r.vehicle_ledger.floor = veh.system().TotalMass() * 9.81 * veh.tire().radius;
+    cmd.brake_effort = 1.0;  // settling: brakes on, no drive
+  }
   try {
-    veh.SetBrakeEffort(cmd.brake_effort);
-    veh.SetDriveTorqueRequest(0.0);
+    if (!resume) {
+      veh.SetBrakeEffort(cmd.brake_effort);
+      veh.SetDriveTorqueRequest(0.0);
+    }
     if (observer) observer->OnStep(sim, cmd);
     for (;;) {
+      if (observer) {
+        observer->AtStepStart(sim, st);
+        if (observer->StopRequested()) {
+          r.interrupted = true;
+          break;
+        }
+      }
       const long k = sim.step() - drive_step;  // steps since the driver's start
       if (k >= 0) {
         if (k == 0) p0 = veh.ChassisFramePosition();
@@ -113,10 +130,6 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
         r.vehicle_ledger.Sample(veh.Energy(), sim.driver_time());
         if (r.vehicle_ledger.Broken(kLedgerTolerance)) throw SimulationError(Unstable(sim, r.vehicle_ledger));
       }
-      if (observer && observer->StopRequested()) {
-        r.interrupted = true;
-        break;
-      }
       sim.Step(terrain);
       if (observer) observer->OnStep(sim, cmd);
     }
@@ -132,11 +145,11 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
   r.steps = sim.step();
   r.exchanges = sim.exchanges();
   r.sim_time = r.history.empty() ? 0.0 : r.history.back().t;
-  r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  r.wall_time = st.WallTime();
   r.smg = DetectSpeedMadeGood(r.history, p.plateau, p.driver.v_max);
   r.steady = SteadyWindowFigures(r.history, p.plateau.window, veh.system().TotalMass(), p.grade_deg,
                                  p.side_slope_deg);
-  return r;
+  return std::move(r);
 }
 
 }  // namespace dem_mobility::core

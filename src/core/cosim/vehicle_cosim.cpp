@@ -1,4 +1,5 @@
 #include "dem_mobility/core/cosim/vehicle_cosim.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include <cmath>
 
@@ -97,5 +98,24 @@ void VehicleCoSim::Step(TerrainPort& terrain) {
   if (sys.step_count() % coupling_ == 0) Exchange(terrain);
   sys.EndStep();
 }
+
+template <class Ar>
+void VehicleCoSim::Io(Ar& ar) {
+  ar.Tag("vehicle_cosim");
+  vehicle_->Io(ar);
+  ar(dt_, coupling_, limit_, settle_steps_, exchanges_, last_exchange_, checked_stiffness_, checked_damping_, states_,
+     wrenches_);
+  if constexpr (Ar::kLoading) {
+    if (!(dt_ > 0.0) || coupling_ < 1 || settle_steps_ < 0) ar.Fail("the vehicle's time step is not one");
+    if (states_.size() != kWheels || wrenches_.size() != kWheels) ar.Fail("the wheels' exchange does not match the wheels");
+  }
+}
+
+void VehicleCoSim::Restore(StateReader& in) {
+  DM_DEMAND(dt_ == 0.0);
+  Io(in);
+}
+
+void VehicleCoSim::Save(StateWriter& out) const { const_cast<VehicleCoSim*>(this)->Io(out); }
 
 }  // namespace dem_mobility::core

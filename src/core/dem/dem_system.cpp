@@ -1,4 +1,5 @@
 #include "dem_mobility/core/dem/dem_system.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include <algorithm>
 #include <cmath>
@@ -316,5 +317,21 @@ Vector3d DemSystem::Momentum() const {
     if (ps_.live(i)) p += mass_ * ps_.v[i];
   return p;
 }
+
+template <class Ar>
+void DemSystem::Io(Ar& ar) {
+  ar.Tag("dem");
+  ar(gravity_, dt_, time_, step_, builds_, overflow_builds_, finalized_, rebuild_, ledger_, plastic_ledger_,
+     plastic_before_, adhesion_before_, plastic_de_, plastic_changed_);
+  ps_.Io(ar);
+  lists_.Io(ar);
+  walls_.Io(ar);
+  if constexpr (Ar::kLoading) {
+    const size_t n = ps_.x.size();
+    if (lists_.list_begin().size() != n) ar.Fail("the neighbour lists do not match the particle slots");
+  }
+}
+template void DemSystem::Io(StateWriter&);
+template void DemSystem::Io(StateReader&);
 
 }  // namespace dem_mobility::core

@@ -1,4 +1,5 @@
 #include "dem_mobility/core/dem/neighbour_list.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include <cmath>
 #include <omp.h>
@@ -291,5 +292,23 @@ size_t NeighbourList::MemoryBytes() const {
   for (const auto& a : found_) b += bytes(a);
   return b;
 }
+
+template <class Ar>
+void NeighbourList::Io(Ar& ar) {
+  ar.Tag("neighbour_lists");
+  ar(nbr_begin_, nbr_end_, nbr_cap_, nbr_, hist_, touching_, grid_lo_, grid_dims_, grid_stride_, cell_start_,
+     added_since_build_, slab_axis_, cells_per_slab_, slab_of_, slab_start_, slab_added_);
+  if constexpr (Ar::kLoading) {
+    if (nbr_.size() != hist_.size() || nbr_.size() != touching_.size()) ar.Fail("the pair lists differ in length");
+    if (nbr_begin_.size() != nbr_end_.size() || nbr_begin_.size() != nbr_cap_.size())
+      ar.Fail("the list bounds differ in length");
+    for (size_t i = 0; i < nbr_begin_.size(); ++i)
+      if (nbr_begin_[i] < 0 || nbr_begin_[i] > nbr_end_[i] || nbr_end_[i] > nbr_cap_[i] ||
+          nbr_cap_[i] > static_cast<int>(nbr_.size()))
+        ar.Fail("a list's bounds lie outside the pairs");
+  }
+}
+template void NeighbourList::Io(StateWriter&);
+template void NeighbourList::Io(StateReader&);
 
 }  // namespace dem_mobility::core

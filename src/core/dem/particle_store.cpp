@@ -1,4 +1,5 @@
 #include "dem_mobility/core/dem/particle_store.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include "dem_mobility/core/common/error.h"
 
@@ -89,5 +90,22 @@ size_t ParticleStore::MemoryBytes() const {
          bytes(max_repulsion) + bytes(max_tension) + bytes(overlap) + bytes(state) + bytes(held) + bytes(id_of_slot) + bytes(hot) +
          bytes(ids_) + bytes(free_slots_);
 }
+
+template <class Ar>
+void ParticleStore::Io(Ar& ar) {
+  ar.Tag("particles");
+  ar(x, v, f, x_built, plastic, adhesion_max, max_repulsion, max_tension, overlap, state, held, id_of_slot, hot, ids_,
+     free_slots_, removed_);
+  if constexpr (Ar::kLoading) {
+    const size_t n = x.size();
+    for (size_t len : {v.size(), f.size(), x_built.size(), plastic.size(), adhesion_max.size(), max_repulsion.size(),
+                       max_tension.size(), overlap.size(), state.size(), held.size(), id_of_slot.size()})
+      if (len != n) ar.Fail("the particle arrays differ in length");
+    for (const IdRecord& r : ids_)
+      if (r.slot >= static_cast<int>(n)) ar.Fail("a particle's slot lies beyond the slots");
+  }
+}
+template void ParticleStore::Io(StateWriter&);
+template void ParticleStore::Io(StateReader&);
 
 }  // namespace dem_mobility::core

@@ -1,4 +1,5 @@
 #include "dem_mobility/core/dem/wall_contacts.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -362,5 +363,32 @@ size_t WallContacts::MemoryBytes() const {
   for (const std::vector<int>& c : chunk_tris_) b += bytes(c);
   return b;
 }
+
+template <class Ar>
+void WallContacts::Io(Ar& ar) {
+  ar.Tag("walls");
+  ar.Same(static_cast<long>(walls_.size()), "walls");
+  for (DemWall& w : walls_) {
+    ar.Tag(w.name.c_str());
+    ar.Same(static_cast<long>(w.mesh.vertices.size()), "the wall's vertices");
+    ar.Same(static_cast<long>(w.mesh.faces.size()), "the wall's triangles");
+    ar(w.position, w.rotation, w.velocity, w.angular_velocity, w.friction, w.adhesion_factor, w.wrench_point, w.force,
+       w.moment, w.normal_force, w.contacts);
+  }
+  ar.Tag("wall_candidates");
+  ar(builds_, tri_lo_, tri_hi_, chunk_tris_, count_, vertices_, built_vertices_, built_particle_displacement_,
+     tri_start_, tri_of_slot_, hist_, touching_, chunk_);
+  if constexpr (Ar::kLoading) {
+    if (hist_.size() != touching_.size()) ar.Fail("the wall histories differ in length");
+    if (vertices_.size() != walls_.size() || (!built_vertices_.empty() && built_vertices_.size() != walls_.size()))
+      ar.Fail("the walls' vertices do not match the walls");
+    for (size_t w = 0; w < vertices_.size(); ++w)
+      if (vertices_[w].size() != walls_[w].mesh.vertices.size()) ar.Fail("a wall's vertices do not match its mesh");
+    for (int t : tri_of_slot_)
+      if (t < 0 || t >= static_cast<int>(tris_.size())) ar.Fail("a candidate triangle lies beyond the walls'");
+  }
+}
+template void WallContacts::Io(StateWriter&);
+template void WallContacts::Io(StateReader&);
 
 }  // namespace dem_mobility::core

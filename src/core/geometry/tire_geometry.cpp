@@ -1,4 +1,5 @@
 #include "dem_mobility/core/geometry/tire_geometry.h"
+#include "dem_mobility/core/common/input_files.h"
 
 #include <cmath>
 #include <fstream>
@@ -166,6 +167,7 @@ TireGeometry TireGeometry::Read(const YamlReader& y) {
 TriMesh LoadObjMesh(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ConfigError(path + ": cannot open the mesh file");
+  NoteInputFile(path);  // (what a checkpoint records of the run: common/input_files.h)
   TriMesh m;
   std::string line;
   int no = 0;

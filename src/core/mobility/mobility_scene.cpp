@@ -1,8 +1,47 @@
 #include "dem_mobility/core/mobility/mobility_scene.h"
 
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 namespace dem_mobility::core {
+
+namespace {
+// a checkpoint file: this line, the format's version, then the state (StateWriter)
+constexpr char kMagic[] = "dem_mobility checkpoint\n";
+constexpr uint32_t kFormat = 1;
+}  // namespace
+
+void CheckpointIdentity::CheckRestart(const std::string& checkpoint, const std::string& scene,
+                                      const std::vector<std::string>& ovr) const {
+  const std::string who = checkpoint + ": checkpoint of the run of " + scene_file + " at t = " +
+                          detail::Concat(driver_time) + " s (step " + std::to_string(step) + "): ";
+  std::error_code ec;
+  const std::string abs = std::filesystem::absolute(scene, ec).lexically_normal().string();
+  if (abs != scene_file) throw ConfigError(who + "it is not a checkpoint of " + abs);
+  if (ovr != overrides) {
+    std::string was, now;
+    for (const std::string& o : overrides) was += " " + o;
+    for (const std::string& o : ovr) now += " " + o;
+    throw ConfigError(who + "it was run with the overrides [" + was + " ], not [" + now +
+                      " ]: a restart takes the same ones");
+  }
+  if (executable != ExecutableFingerprint())
+    throw ConfigError(who + "it was written by another build of this program: a restart must run the build that "
+                            "wrote it (another may step differently)");
+  for (const InputFile& f : files) {
+    bool ok = false;
+    const uint64_t h = FileFingerprint(f.path, &ok);
+    if (!ok) throw ConfigError(who + "its input file " + f.path + " cannot be read any more");
+    if (h != f.fingerprint)
+      throw ConfigError(who + "its input file " + f.path + " has changed since the run began: a restart goes on only "
+                              "with the inputs it began with");
+  }
+}
 
 MobilityRun::MobilityRun(const MobilityRunParams& p, const std::function<bool()>& stop)
     : spec_(VehicleSpec::Load(p.vehicle_file)),
@@ -24,8 +63,69 @@ MobilityRun::MobilityRun(const MobilityRunParams& p, std::unique_ptr<TerrainMode
   sim_.Start(port_);
 }
 
-MobilityRunResult MobilityRun::Run(CoSimObserver* observer) {
-  return RunCoSimulation(sim_, port_, driver_, observer);
+MobilityRun::MobilityRun(const MobilityRunParams& p, StateReader& in, CoSimLoopState* loop)
+    : spec_(VehicleSpec::Load(p.vehicle_file)),
+      terrain_(RestoreTerrainModel(p.terrain_file, TerrainVehicleOf(spec_), p.terrain_overrides, in)),
+      port_(*terrain_),
+      driver_(p.driver, spec_),
+      sim_(p, spec_) {
+  // (the soil's gravity, its energy watch and the vehicle's time step are the checkpoint's)
+  sim_.Restore(in);
+  driver_.Io(in);
+  loop->Io(in);
+  in.Tag("end");
+  if (in.left() != 0) in.Fail(detail::Concat(in.left(), " bytes more than the run holds"));
+}
+
+MobilityRunResult MobilityRun::Run(CoSimObserver* observer, const CoSimLoopState* resume) {
+  return RunCoSimulation(sim_, port_, driver_, observer, resume);
+}
+
+uint64_t MobilityRun::WriteCheckpoint(const std::string& path, CheckpointIdentity id, const CoSimLoopState& loop) const {
+  id.step = sim_.step();
+  id.driver_time = sim_.driver_time();
+  std::ostringstream os(std::ios::binary);
+  os.write(kMagic, sizeof(kMagic) - 1);
+  os.write(reinterpret_cast<const char*>(&kFormat), sizeof(kFormat));
+  StateWriter w(&os);
+  id.Io(w);
+  terrain_->SaveState(w);
+  sim_.Save(w);
+  const_cast<SceneDriver&>(driver_).Io(w);
+  CoSimLoopState st = loop;
+  st.r.wall_time = loop.WallTime();
+  st.Io(w);
+  w.Tag("end");
+  const std::string bytes = os.str();
+  WriteFileAtomically(path, bytes);
+  return bytes.size();
+}
+
+std::unique_ptr<MobilityRun> MobilityRun::FromCheckpoint(const std::string& path, const MobilityRunParams& p,
+                                                         const std::string& scene_file,
+                                                         const std::vector<std::string>& overrides,
+                                                         CoSimLoopState* loop, CheckpointIdentity* id_out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path + ": cannot open the checkpoint (missing or unreadable)");
+  in.seekg(0, std::ios::end);
+  const auto size = static_cast<uint64_t>(in.tellg());
+  in.seekg(0);
+  const size_t head = sizeof(kMagic) - 1 + sizeof(kFormat);
+  std::string magic(sizeof(kMagic) - 1, '\0');
+  uint32_t format = 0;
+  if (size < head || !in.read(magic.data(), static_cast<std::streamsize>(magic.size())) || magic != kMagic)
+    throw ConfigError(path + ": not a dem_mobility checkpoint");
+  in.read(reinterpret_cast<char*>(&format), sizeof(format));
+  if (format != kFormat)
+    throw ConfigError(path + ": checkpoint format " + std::to_string(format) + ", this program reads format " +
+                      std::to_string(kFormat));
+  StateReader r(&in, path, size - head);
+  CheckpointIdentity id;
+  id.Io(r);
+  id.CheckRestart(path, scene_file, overrides);
+  auto run = std::make_unique<MobilityRun>(p, r, loop);
+  if (id_out) *id_out = id;
+  return run;
 }
 
 }  // namespace dem_mobility::core

@@ -1,4 +1,5 @@
 #include "dem_mobility/core/multibody/multibody_system.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -257,5 +258,33 @@ Vector3d MultibodySystem::CenterOfMass() const {
     if (!b.fixed) c += b.mass * b.x;
   return c / TotalMass();
 }
+
+template <class Ar>
+void MultibodySystem::Io(Ar& ar) {
+  ar.Tag("multibody");
+  ar.Same(static_cast<long>(bodies_.size()), "bodies");
+  for (RigidBody& b : bodies_) b.Io(ar);
+  ar.Same(static_cast<long>(couplings.size()), "rotational couplings");
+  for (RotationalCoupling& c : couplings) ar(c.g);
+  ar.Same(static_cast<long>(torques.size()), "axis torques");
+  for (AxisTorque& t : torques) ar(t.torque);
+  ar.Same(static_cast<long>(line_constraints.size()), "line constraints");
+  for (LineConstraint& l : line_constraints) ar(l.target);
+  ar.Same(static_cast<long>(point_contacts.size()), "point contacts");
+  for (PointSetContact& c : point_contacts) {
+    ar(c.history, c.last, c.applied_step);  // (one anchor per point, or none before the first Apply)
+  }
+  ar(work_, e0_, last_ext_force_, last_ext_torque_, last_source_torque_, gravity_, dt_, time_, step_, finalized_);
+  if constexpr (Ar::kLoading) {
+    if (last_ext_force_.size() != bodies_.size() || last_ext_torque_.size() != bodies_.size() ||
+        last_source_torque_.size() != torques.size())
+      ar.Fail("the work ledger's entries do not match the bodies and torques");
+    for (const PointSetContact& c : point_contacts)
+      if (!c.history.empty() && c.history.size() != c.points.size())
+        ar.Fail("a point contact's anchors do not match its points");
+  }
+}
+template void MultibodySystem::Io(StateWriter&);
+template void MultibodySystem::Io(StateReader&);
 
 }  // namespace dem_mobility::core

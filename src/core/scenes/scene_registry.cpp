@@ -4,10 +4,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/input_files.h"
 #include "dem_mobility/core/common/registry.h"
+#include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/mobility/mobility_scene.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
@@ -60,45 +63,103 @@ ResultFile BeforeTheRun(const MobilityRunParams& p, const SceneRunOptions& o,
 ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) {
   const MobilityRunParams p = MobilityRunParams::Read(reader);
   const auto wall0 = std::chrono::steady_clock::now();
+  // what the checkpoints record of the run: the scene (read before this), then every input file
+  // the run reads from here on
+  const size_t inputs_mark = InputFileCount();
+  NoteInputFile(reader.file());
   std::unique_ptr<MobilityRun> made;
-  try {
-    made = std::make_unique<MobilityRun>(p, [s = o.stop] { return s && s->load(std::memory_order_relaxed); });
-  } catch (const Interrupted& e) {
-    // stopped while the terrain prepared, before the run began: the result and the history (its
-    // header) say so, the result with how far the preparation had come
-    return BeforeTheRun(p, o, wall0, "interrupted", e.what());
-  } catch (const SimulationError& e) {
-    // a numerical failure in the terrain's preparation or the opening exchange (a watchdog): the
-    // result says so, as a failure during a run does
-    return BeforeTheRun(p, o, wall0, "error", e.what());
+  CoSimLoopState resume;
+  CheckpointIdentity restarted;
+  const bool restart = !o.restart_file.empty();
+  if (restart) {
+    // (ConfigError for a checkpoint of another run, or one that does not read)
+    made = MobilityRun::FromCheckpoint(o.restart_file, p, o.scene_file.empty() ? reader.file() : o.scene_file,
+                                       o.overrides, &resume, &restarted);
+    std::printf("restarted from %s at t = %.3f s (step %ld; %.0f s of wall time before)\n", o.restart_file.c_str(),
+                restarted.driver_time, restarted.step, resume.r.wall_time);
+  } else {
+    try {
+      made = std::make_unique<MobilityRun>(p, [s = o.stop] { return s && s->load(std::memory_order_relaxed); });
+    } catch (const Interrupted& e) {
+      // stopped while the terrain prepared, before the run began: the result and the history (its
+      // header) say so, the result with how far the preparation had come
+      return BeforeTheRun(p, o, wall0, "interrupted", e.what());
+    } catch (const SimulationError& e) {
+      // a numerical failure in the terrain's preparation or the opening exchange (a watchdog): the
+      // result says so, as a failure during a run does
+      return BeforeTheRun(p, o, wall0, "error", e.what());
+    }
   }
   MobilityRun& run = *made;
+  CheckpointIdentity identity;
+  identity.scene_file = restart ? restarted.scene_file
+                                : std::filesystem::absolute(o.scene_file.empty() ? reader.file() : o.scene_file)
+                                      .lexically_normal()
+                                      .string();
+  identity.overrides = o.overrides;
+  identity.files = restart ? restarted.files : InputFilesSince(inputs_mark);
+  identity.executable = ExecutableFingerprint();
   const TimeStepLimit& lim = run.sim().limit();
   std::printf("scene %s: grade %.1f deg, %d bodies, dt %.3g s (critical %.3g s, %s), %.1f s simulated\n",
               p.file.c_str(), p.grade_deg, run.vehicle().system().num_bodies() - 1, run.dt(), lim.dt_crit,
               lim.element.c_str(), p.duration);
   std::fflush(stdout);
-  // progress on the console about once a second of wall time
+  // progress on the console about once a second of wall time; the checkpoints
   class Progress final : public CoSimObserver {
    public:
-    Progress(double duration, bool quiet, const std::atomic<bool>* stop)
-        : duration_(duration), quiet_(quiet), stop_(stop) {}
-    bool StopRequested() override { return stop_ && stop_->load(std::memory_order_relaxed); }
+    Progress(const MobilityRun& run, const SceneRunOptions& o, const CheckpointIdentity& id, double duration,
+             bool restarted)
+        : run_(run), o_(o), id_(id), duration_(duration), restarted_(restarted) {}
+    bool StopRequested() override { return o_.stop && o_.stop->load(std::memory_order_relaxed); }
+    void AtStepStart(const VehicleCoSim& sim, const CoSimLoopState& st) override {
+      if (o_.checkpoint_file.empty()) return;
+      // when the run begins to step, every checkpoint_every wall seconds (looked at every 256
+      // steps), and when it is told to stop
+      const bool first = written_ == 0 && !failed_ && !restarted_;
+      if (!first && !StopRequested() && ((sim.step() & 255) != 0 || since_.Elapsed() < o_.checkpoint_every)) return;
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        const uint64_t bytes = run_.WriteCheckpoint(o_.checkpoint_file, id_, st);
+        ++written_;
+        last_t_ = sim.driver_time();
+        std::printf("  checkpoint %s: t = %.3f s, %.1f MB in %.2f s\n", o_.checkpoint_file.c_str(), last_t_,
+                    bytes / 1e6, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      } catch (const ConfigError& e) {  // (the run goes on; its result says the checkpoint failed)
+        failed_ = true;
+        error_ = e.what();
+        std::printf("  checkpoint failed: %s\n", e.what());
+      }
+      std::fflush(stdout);
+      since_ = Ticker(0.0);
+    }
     void OnStep(const VehicleCoSim& sim, const DriverCommand&) override {
-      if (quiet_ || (sim.step() & 255) != 0 || !ticker_.Due()) return;
-      const double t = std::max(0.0, sim.driver_time()), rtf = sim.time() / std::max(ticker_.Elapsed(), 1e-9);
+      if (o_.quiet || (sim.step() & 255) != 0 || !ticker_.Due()) return;
+      const double t = std::max(0.0, sim.driver_time());
+      if (t0_ < 0.0) t0_ = sim.time();
+      const double rtf = (sim.time() - t0_) / std::max(ticker_.Elapsed(), 1e-9);
       std::printf("  t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s\n", t, duration_,
                   sim.vehicle().ForwardSpeed(), rtf, (duration_ - t) / std::max(rtf, 1e-9));
       std::fflush(stdout);
     }
+    int written() const { return written_; }
+    double last_t() const { return last_t_; }
+    const std::string& error() const { return error_; }
 
    private:
+    const MobilityRun& run_;
+    const SceneRunOptions& o_;
+    const CheckpointIdentity& id_;
     double duration_;
-    bool quiet_;
-    const std::atomic<bool>* stop_;
+    bool restarted_;
+    double t0_ = -1.0;  ///< the simulated time progress is reckoned from (this process's start)
     Ticker ticker_{1.0};
-  } progress(p.duration, o.quiet, o.stop);
-  MobilityRunResult r = run.Run(&progress);
+    Ticker since_{0.0};  ///< since the last checkpoint
+    int written_ = 0;
+    bool failed_ = false;
+    double last_t_ = 0.0;
+    std::string error_;
+  } progress(run, o, identity, p.duration, restart);
+  MobilityRunResult r = run.Run(&progress, restart ? &resume : nullptr);
   try {
     if (!o.history_file.empty()) {
       WriteMobilityHistory(r, o.history_file);
@@ -118,7 +179,27 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
               r.smg.value / 0.44704, r.smg.status.c_str(), r.smg.window_slope);
   std::printf("run: %ld steps, %.2f s simulated in %.2f s wall (real-time factor %.2f)\n", r.steps, r.sim_time,
               r.wall_time, r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0);
-  return MobilityResultFile(r, p, {}, &run.terrain());
+  ResultFile f = MobilityResultFile(r, p, {}, &run.terrain());
+  if (restart) {
+    f.Set("restarted_from", o.restart_file);
+    f.Set("restarted_at", restarted.driver_time);
+  }
+  if (!o.checkpoint_file.empty()) {
+    f.Set("checkpoints_written", progress.written());
+    if (!progress.error().empty()) f.Set("checkpoint_error", progress.error());
+    const std::string status = r.Status();
+    if (status == "error" || status == "interrupted") {
+      if (progress.written() > 0) {
+        f.Set("checkpoint", o.checkpoint_file);
+        f.Set("checkpoint_at", progress.last_t());
+        std::printf("checkpoint kept: %s (t = %.3f s): --restart %s takes the run up from there\n",
+                    o.checkpoint_file.c_str(), progress.last_t(), o.checkpoint_file.c_str());
+      }
+    } else if (progress.written() > 0) {
+      std::remove(o.checkpoint_file.c_str());  // the run has ended: its result is what remains
+    }
+  }
+  return f;
 }
 
 void CheckMobilityScene(const YamlReader& reader) {

@@ -1,4 +1,5 @@
 #include "dem_mobility/core/scenes/soil_prep.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include <algorithm>
 #include <cmath>
@@ -225,5 +226,23 @@ double TopParticle(const DemSystem& s) {
   s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) { top = std::max(top, x.z()); });
   return top;
 }
+
+template <class Ar>
+void SoilPreparation::Io(Ar& ar) {
+  ar.Tag("preparation");
+  ar(phase_, phase_steps_, height_poured_, height_consolidated_);
+  unsigned char has_hold = hold_ ? 1 : 0;
+  ar(has_hold);
+  if constexpr (Ar::kLoading) {
+    if (static_cast<int>(phase_) < 0 || phase_ > Phase::kDone) ar.Fail("the preparation's phase is not one");
+    if (!has_hold)
+      hold_.reset();
+    else if (!hold_)
+      hold_ = std::make_unique<LidHold>(s_, lid_, area_, p_.lid_pressure, p_.lid_speed, LidHold::Start::kReaches95Percent);
+  }
+  if (hold_) hold_->Io(ar);
+}
+template void SoilPreparation::Io(StateWriter&);
+template void SoilPreparation::Io(StateReader&);
 
 }  // namespace dem_mobility::core

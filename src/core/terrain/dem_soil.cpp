@@ -1,4 +1,5 @@
 #include "dem_mobility/core/terrain/dem_soil.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -415,7 +416,14 @@ DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire,
   }
   bin_->ShiftZ(-bin_->surface_height() - start_gap_);
   if (p.patch.enabled) patch_ = std::make_unique<SoilPatch>(bin_.get(), p.patch, p.seed);
-  // the display surface: the bin's consolidated top (with a patch, over the whole travel)
+  MakeSurfaceMesh();
+  wrenches_.assign(wheels, WheelWrench());
+  bin_->WatchEnergy(0.05);  // the run's energy ledger from here (20 samples per second of soil time)
+  prepare_wall_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void DemSoilTerrain::MakeSurfaceMesh() {
+  const DemSoilParams& p = bin_->params();
   const SoilBinLevel& l = p.level;
   const double z = bin_->surface_height();
   const Vector3d o = p.origin - Vector3d(0.0, 0.5 * l.width, 0.0);
@@ -423,9 +431,6 @@ DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire,
   surface_mesh_.vertices = {Vector3d(o.x(), o.y(), z), Vector3d(o.x() + length, o.y(), z),
                             Vector3d(o.x() + length, o.y() + l.width, z), Vector3d(o.x(), o.y() + l.width, z)};
   surface_mesh_.faces = {{0, 1, 2}, {0, 2, 3}};
-  wrenches_.assign(wheels, WheelWrench());
-  bin_->WatchEnergy(0.05);  // the run's energy ledger from here (20 samples per second of soil time)
-  prepare_wall_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 DemSoilTerrain::DemSoilTerrain(const DemSoilTerrain& o)
@@ -634,6 +639,58 @@ TerrainDescription DescribeDemSoilTerrain(const YamlReader& y) {
   d.time_step = p.level.time_step;
   d.fidelity = p.level.name;
   return d;
+}
+
+template <class Ar>
+void DemSoilBin::Io(Ar& ar) {
+  ar.Tag("soil_bin");
+  dem_->Io(ar);
+  prep_->Io(ar);
+  ar(centres_, surface_, shift_, watch_, watch_every_, watch_start_, watch_plastic_);
+  if constexpr (Ar::kLoading)
+    if (centres_.size() != tire_walls_.size()) ar.Fail("the tires' centres do not match the tires");
+}
+template void DemSoilBin::Io(StateWriter&);
+template void DemSoilBin::Io(StateReader&);
+
+template <class Ar>
+void DemSoilTerrain::Io(Ar& ar) {
+  ar.Tag("dem_soil_terrain");
+  bin_->Io(ar);
+  ar(prepare_wall_, advance_wall_, start_gap_, states_, wrenches_);
+  unsigned char has_patch = patch_ ? 1 : 0;
+  ar(has_patch);
+  if constexpr (Ar::kLoading) {
+    const DemSoilParams& p = bin_->params();
+    if (has_patch != (p.patch.enabled ? 1 : 0))
+      ar.Fail(std::string("the checkpoint's soil ") + (has_patch ? "has" : "has no") + " moving patch, the scene's " +
+              (p.patch.enabled ? "has one" : "has none"));
+    if (!bin_->prepared()) ar.Fail("the soil in it is not prepared");
+    if (has_patch && !patch_) patch_ = std::make_unique<SoilPatch>(bin_.get(), p.patch, p.seed);
+    if (wrenches_.size() != static_cast<size_t>(bin_->wheels()) ||
+        (!states_.empty() && states_.size() != static_cast<size_t>(bin_->wheels())))
+      ar.Fail("the wheels' states do not match the tires");
+  }
+  if (patch_) patch_->Io(ar);
+}
+
+DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels, StateReader& in)
+    : bin_(std::make_unique<DemSoilBin>(p, tire, wheels)) {
+  description_.file = p.file;
+  description_.model = "dem_soil";
+  description_.cone_index = p.ConeIndex();
+  description_.time_step = p.level.time_step;
+  description_.fidelity = p.level.name;
+  wrenches_.assign(wheels, WheelWrench());
+  Io(in);
+  MakeSurfaceMesh();
+}
+
+void DemSoilTerrain::SaveState(StateWriter& out) const { const_cast<DemSoilTerrain*>(this)->Io(out); }
+void DemSoilTerrain::LoadState(StateReader& in) { Io(in); }
+
+std::unique_ptr<TerrainModel> RestoreDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle, StateReader& in) {
+  return std::make_unique<DemSoilTerrain>(ReadDemSoilFor(y, vehicle), vehicle.tire, vehicle.wheels, in);
 }
 
 }  // namespace dem_mobility::core

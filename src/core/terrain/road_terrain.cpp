@@ -1,4 +1,5 @@
 #include "dem_mobility/core/terrain/road_terrain.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include <algorithm>
 #include <cmath>
@@ -95,8 +96,23 @@ class RoadTerrain final : public TerrainModel {
   }
   void GetWrenches(std::vector<WheelWrench>* wrenches) const override { *wrenches = wrenches_; }
   void Advance(double /*dt*/) override {}
+  void SaveState(StateWriter& out) const override { const_cast<RoadTerrain*>(this)->Io(out); }
+  void LoadState(StateReader& in) override { Io(in); }
 
  private:
+  /// The exchanged wheel states, the tires' contact anchors and the wrenches.
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar.Tag("rigid_road");
+    for (RigidBody& b : bodies_) b.Io(ar);
+    for (TireContact& t : tires_) {
+      ar(t.last, t.history);  // (one anchor per tire vertex, or none before the first contact)
+    }
+    ar(wrenches_);
+    if constexpr (Ar::kLoading)
+      if (wrenches_.size() != kWheels) ar.Fail("the road's wrenches do not match the wheels");
+  }
+
   TerrainDescription description_;
   TireGeometry tire_;
   std::unique_ptr<TerrainMesh> mesh_;

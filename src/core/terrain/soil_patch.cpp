@@ -1,4 +1,5 @@
 #include "dem_mobility/core/terrain/soil_patch.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include <algorithm>
 #include <cmath>
@@ -425,5 +426,24 @@ void WritePatchChecks(const PatchStats& s, const std::string& path) {
     out << c.t << "," << c.front_x << "," << c.density_ratio << "," << c.surface_offset << "," << c.reemitted_fraction
         << "," << c.particles << "\n";
 }
+
+template <class Ar>
+void SoilPatch::Io(Ar& ar) {
+  ar.Tag("soil_patch");
+  ar(rng_, d_, bed_length_, width_, floor_z_, surface0_, depth0_, front_x0_, template_length_, min_site_x_, walls_y_,
+     bands_, band_width_, period_, seam_clash_, centre0_, centre_, radius_, n0_, sites_, layer_begin_, copy_origin_,
+     layer_, free_, zone_, leaving_, prev_layer_first_id_, layer_first_id_, started_, tool_offset_, tool_z_,
+     front_offset_, steps_, check_every_, bed_vx_sum_, bed_vx_count_, ratio_sum_, offset_sum_, stats_);
+  if constexpr (Ar::kLoading) {
+    for (int i : layer_begin_)
+      if (i < 0 || i > static_cast<int>(sites_.size())) ar.Fail("an emitter layer lies beyond the template");
+    for (int i : free_)
+      if (i < 0 || i >= static_cast<int>(sites_.size())) ar.Fail("a free site lies beyond the template");
+    if (layer_ >= 0 && layer_ + 1 >= static_cast<int>(layer_begin_.size())) ar.Fail("the emitter's layer is not one");
+    if (check_every_ < 1) ar.Fail("the patch's check period is not one");
+  }
+}
+template void SoilPatch::Io(StateWriter&);
+template void SoilPatch::Io(StateReader&);
 
 }  // namespace dem_mobility::core

@@ -21,7 +21,7 @@ const std::vector<TerrainKind>& TerrainKinds() {
        [](const YamlReader& y, const TerrainVehicle& v, const std::function<bool()>& stop) {
          return MakeDemSoilTerrain(y, v, stop);
        },
-       &DescribeDemSoilTerrain, &CheckDemSoilTerrain},
+       &DescribeDemSoilTerrain, &CheckDemSoilTerrain, &RestoreDemSoilTerrain},
   };
   return kinds;
 }
@@ -53,6 +53,16 @@ void CheckTerrainModel(const YamlReader& y, const TerrainVehicle& vehicle) { Fin
 void CheckTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
                        const std::vector<std::string>& overrides) {
   CheckTerrainModel(YamlReader::LoadWithOverrides(terrain_file, overrides), vehicle);
+}
+
+std::unique_ptr<TerrainModel> RestoreTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
+                                                  const std::vector<std::string>& overrides, StateReader& in) {
+  const YamlReader y = YamlReader::LoadWithOverrides(terrain_file, overrides);
+  const TerrainKind& kind = FindTerrainKind(y);
+  if (kind.restore) return kind.restore(y, vehicle, in);
+  std::unique_ptr<TerrainModel> m = kind.make(y, vehicle, {});
+  m->LoadState(in);
+  return m;
 }
 
 TerrainDescription DescribeTerrain(const std::string& terrain_file, const std::vector<std::string>& overrides) {

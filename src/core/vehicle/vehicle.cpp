@@ -1,4 +1,5 @@
 #include "dem_mobility/core/vehicle/vehicle.h"
+#include "dem_mobility/core/common/state_archive.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/QR>
@@ -153,5 +154,14 @@ std::vector<MultibodySystem::BodyMode> Vehicle::WheelContactModes(double stiffne
   }
   return modes;
 }
+
+template <class Ar>
+void Vehicle::Io(Ar& ar) {
+  ar.Tag("vehicle");
+  system_.Io(ar);
+  ar(brake_angle_, brake_anchor_, drive_request_, brake_effort_, servo_work_, wrench_);
+}
+template void Vehicle::Io(StateWriter&);
+template void Vehicle::Io(StateReader&);
 
 }  // namespace dem_mobility::core

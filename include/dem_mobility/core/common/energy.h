@@ -7,6 +7,7 @@
 namespace dem_mobility::core {
 
 struct EnergyReport {
+  using StateBulk = void;  // (a checkpoint copies it as bytes: common/state_archive.h)
   double kinetic = 0.0;
   double gravitational = 0.0;  ///< -m g . x summed
   double elastic = 0.0;        ///< penalty springs, springs, contacts
@@ -62,6 +63,12 @@ struct LedgerWatch {
   /// Whether the ledger fell below zero by more than `tolerance` of Scale(), or is not finite.
   bool Broken(double tolerance) const { return nan_ || least < -tolerance * Scale(); }
   bool finite() const { return !nan_; }
+  /// Its state in a checkpoint (common/state_archive.h).
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar(samples, dissipated, least, least_time, largest_fall, throughput, kinetic_max, floor, base_, last_work_,
+       last_exchanged_, nan_);
+  }
 
  private:
   double base_ = 0.0, last_work_ = 0.0, last_exchanged_ = 0.0;

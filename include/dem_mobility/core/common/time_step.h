@@ -15,6 +15,10 @@ struct TimeStepLimit {
   double dt_crit = 0.0;
   std::string element;
   std::string detail;
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar(dt_crit, element, detail);
+  }
 };
 
 }  // namespace dem_mobility::core

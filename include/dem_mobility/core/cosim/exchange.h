@@ -23,10 +23,15 @@ struct WheelState {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          ///< of the centre [m/s]
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< world frame [rad/s]
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar(position, orientation, velocity, angular_velocity);
+  }
 };
 
 /// The terrain's wrench on one wheel, world frame, about the wheel centre.
 struct WheelWrench {
+  using StateBulk = void;  // (a checkpoint copies it as bytes: common/state_archive.h)
   Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< [N]
   Eigen::Vector3d moment = Eigen::Vector3d::Zero();  ///< [N m]
   double sinkage = 0.0;       ///< deepest penetration [m]

@@ -53,6 +53,11 @@ class SceneDriver final : public DriverPort {
  public:
   SceneDriver(const DriverParams& p, const VehicleSpec& vehicle);
   DriverCommand Exchange(const DriverInput& in) override;
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar.Tag("driver");
+    driver_.Io(ar);
+  }
 
  private:
   PowertrainParams powertrain_;  ///< the driver's engine curves (SpeedDriver refers to them)

@@ -13,6 +13,9 @@
 
 namespace dem_mobility::core {
 
+class StateReader;
+class StateWriter;
+
 class VehicleCoSim {
  public:
   /// The vehicle of `spec` (read from p.vehicle_file) with its tires just touching the plane z = 0.
@@ -24,6 +27,10 @@ class VehicleCoSim {
   /// make dt x coupling_interval a whole multiple of h.
   /// Throws ConfigError (naming the scene file and time_step) for a step above that limit.
   void Start(TerrainPort& terrain);
+  /// Instead of Start: the vehicle and the exchange as a checkpoint has them (common/
+  /// state_archive.h), the time step and coupling as the run written chose them.
+  void Restore(StateReader& in);
+  void Save(StateWriter& out) const;
   /// One step; exchanges with the terrain when the step index is a multiple of the interval.
   void Step(TerrainPort& terrain);
 
@@ -45,6 +52,8 @@ class VehicleCoSim {
   const std::vector<WheelWrench>& wheel_wrenches() const { return wrenches_; }
 
  private:
+  template <class Ar>
+  void Io(Ar& ar);
   void Exchange(TerrainPort& terrain);
   void CheckContactLimit();
   MobilityRunParams p_;

@@ -42,6 +42,7 @@ double ParticleEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const Ne
 
 /// The energy put in from outside since Finalize.
 struct DemLedger {
+  using StateBulk = void;
   double e0 = 0.0;          ///< mechanical energy at Finalize
   double wall_work = 0.0;   ///< the walls' work on the particles (trapezoidal in time)
   double exchanged = 0.0;   ///< particles added less removed, gravity changes, and `plastic`

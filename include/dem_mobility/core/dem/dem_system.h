@@ -156,6 +156,11 @@ class DemSystem {
   /// Bytes held for the particles, neighbour lists, contact histories and walls.
   size_t MemoryBytes() const;
   Eigen::Vector3d Momentum() const;
+  /// Its state in a checkpoint (common/state_archive.h): the particles, lists, walls, clock and
+  /// ledger. A system read back steps on exactly as the one written would have (its walls must
+  /// be those of the same scene; the threads and the pair kernel stay this system's own).
+  template <class Ar>
+  void Io(Ar& ar);
 
  private:
   void Rebuild();

@@ -58,6 +58,10 @@ class NeighbourList {
 
   int contacts() const;  ///< pairs touching at the last force evaluation
   size_t MemoryBytes() const;
+  /// Its state in a checkpoint (common/state_archive.h): the lists, their histories, the build's
+  /// grid and slabs (a restart goes on with the lists it had, not with a new build).
+  template <class Ar>
+  void Io(Ar& ar);
 
  private:
   Eigen::Vector3i CellOf(const Eigen::Vector3d& x) const;

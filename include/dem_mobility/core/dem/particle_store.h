@@ -19,6 +19,7 @@ enum class SlotState : unsigned char {
 
 /// Where the particle with a given ID is.
 struct IdRecord {
+  using StateBulk = void;
   enum class State : unsigned char {
     kLive,     ///< in `slot`
     kRemoved,  ///< removed; `slot` still holds its last state (until the slot is reused)
@@ -40,6 +41,7 @@ void PermuteSlots(std::vector<T>* v, const std::vector<int>& order, size_t width
 /// What the pair sweep reads of a partner, packed into one cache line (written before each sweep
 /// from the per-slot arrays below; the vector kernels gather from it).
 struct alignas(64) HotParticle {
+  using StateBulk = void;
   double x[3], v[3];
   double plastic, adhesion_max;
 };
@@ -93,6 +95,9 @@ class ParticleStore {
     return a[r.slot];
   }
   size_t MemoryBytes() const;
+  /// Its state in a checkpoint (common/state_archive.h): every array and the ID records.
+  template <class Ar>
+  void Io(Ar& ar);
 
  private:
   static double NaNLike(double) { return std::numeric_limits<double>::quiet_NaN(); }

@@ -60,6 +60,7 @@ struct SoilNormalForce {
 
 /// Tangential (history) state of a contact: the elongation of the anchor spring.
 struct TangentialHistory {
+  using StateBulk = void;
   Eigen::Vector3d spring = Eigen::Vector3d::Zero();
 };
 

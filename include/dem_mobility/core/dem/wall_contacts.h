@@ -107,9 +107,15 @@ class WallContacts {
   /// Candidate triangles over all slots at the last build (a measure of the per-step cost).
   long candidates() const { return static_cast<long>(tri_of_slot_.size()); }
   size_t MemoryBytes() const;
+  /// Its state in a checkpoint (common/state_archive.h): the walls' poses, velocities and wrenches,
+  /// the candidates and their histories. The walls themselves (meshes, bins, laws) are the built
+  /// scene's: their number and sizes are checked.
+  template <class Ar>
+  void Io(Ar& ar);
 
  private:
   struct WallTri {
+    using StateBulk = void;
     int wall, face;
   };
   /// A wall's triangles binned in its body frame: cell (ix, iy, iz) lists, in increasing order, the
@@ -122,6 +128,7 @@ class WallContacts {
     int Cell(const Eigen::Vector3d& body) const;
   };
   struct WallSum {
+    using StateBulk = void;
     Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
     double power = 0.0, normal = 0.0;
     int contacts = 0;

@@ -69,6 +69,7 @@ struct MobilityRunParams {
 
 /// One history sample (t from the driver's start).
 struct MobilitySample {
+  using StateBulk = void;  // (a checkpoint copies it as bytes: common/state_archive.h)
   double t, x, speed, speed_command, drive_shaft_speed, drive_torque, brake_effort;
   bool wot_limited;
   std::array<double, kWheels> slip{};     ///< 1 - v / (omega r) per wheel (0 while omega r < 0.05 m/s)
@@ -85,6 +86,10 @@ struct SpeedMadeGood {
   double window_slope = 0.0;///< dv/dt over the judging window [m/s^2]
   double window_std = 0.0;  ///< speed standard deviation in the window [m/s]
   double end_slope = 0.0;   ///< dv/dt over the window's trailing half [m/s^2]
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar(value, status, window_slope, window_std, end_slope);
+  }
 };
 
 /// How long the vehicle has been stalled at the end of the history [s]: the time since the last
@@ -98,6 +103,7 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
 
 /// Means over the detector's judging window (the steady state).
 struct SteadyFigures {
+  using StateBulk = void;
   int samples = 0;
   std::array<double, kWheels> slip{}, sinkage{};
   double traction_coefficient = 0.0;   ///< terrain pull / (m g cos(grade) cos(side slope))
@@ -126,6 +132,12 @@ struct MobilityRunResult {
   std::string error;        ///< empty on success
   /// error | interrupted | the detector's status.
   std::string Status() const;
+  /// What a checkpoint keeps of a run under way (common/state_archive.h): the history, the
+  /// ledger and the counts (the rest is set again when it ends).
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar(history, vehicle_ledger, driver_updates, wall_time, ended_early);
+  }
 };
 
 /// The steady figures over the trailing `window` of the history (vehicle mass m, grade).

@@ -2,13 +2,41 @@
 // directly, through the same loop the nodelets run (cosim/cosim_loop.h).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
+#include <vector>
 
+#include "dem_mobility/core/common/input_files.h"
 #include "dem_mobility/core/cosim/cosim_loop.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 
 namespace dem_mobility::core {
+
+class StateReader;
+
+/// What a checkpoint says of the run it holds: the scene and overrides it was started with, every
+/// input file it read (with the fingerprint of its bytes), the executable that ran it, and where
+/// the run was. A restart goes on only with all of them the same, so that the run taken up again
+/// is, bit for bit, the run that was written.
+struct CheckpointIdentity {
+  std::string scene_file;              ///< absolute
+  std::vector<std::string> overrides;  ///< key=value, as given
+  std::vector<InputFile> files;
+  uint64_t executable = 0;             ///< ExecutableFingerprint()
+  long step = 0;                       ///< the vehicle's step
+  double driver_time = 0.0;            ///< [s] since the driver's start (< 0: settling)
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar.Tag("identity");
+    ar(scene_file, overrides, files, executable, step, driver_time);
+  }
+  /// ConfigError naming `checkpoint` and what differs from the run asked for now (`scene_file`
+  /// and `overrides`): another scene or overrides, an input file changed or gone, another build.
+  void CheckRestart(const std::string& checkpoint, const std::string& scene_file,
+                    const std::vector<std::string>& overrides) const;
+};
 
 class MobilityRun {
  public:
@@ -18,13 +46,29 @@ class MobilityRun {
   explicit MobilityRun(const MobilityRunParams& p, const std::function<bool()>& stop = {});
   /// The same on a terrain built already (e.g. a copy of a prepared soil: one preparation, many runs).
   MobilityRun(const MobilityRunParams& p, std::unique_ptr<TerrainModel> terrain);
-  MobilityRunResult Run(CoSimObserver* observer = nullptr);
+  /// The run of a checkpoint, after its identity (ReadCheckpoint): the terrain restored without
+  /// its preparation, the vehicle, the driver and the loop state (`*loop`) as written.
+  MobilityRun(const MobilityRunParams& p, StateReader& in, CoSimLoopState* loop);
+  /// `resume`: the loop state a checkpoint gave (then the run goes on where it was).
+  MobilityRunResult Run(CoSimObserver* observer = nullptr, const CoSimLoopState* resume = nullptr);
+  /// Writes the whole run (`id` with the vehicle's step filled in, the terrain, the vehicle, the
+  /// driver, the loop state `loop`) to `path` through a temporary file (the previous checkpoint
+  /// stays whole until the new one is); returns its size in bytes. ConfigError naming the path.
+  uint64_t WriteCheckpoint(const std::string& path, CheckpointIdentity id, const CoSimLoopState& loop) const;
   VehicleCoSim& sim() { return sim_; }
   Vehicle& vehicle() { return sim_.vehicle(); }
   TerrainPort& terrain_port() { return port_; }
   const TerrainModel& terrain() const { return *terrain_; }
   TerrainModel& mutable_terrain() { return *terrain_; }
   double dt() const { return sim_.dt(); }
+
+  /// A checkpoint's run taken up again: reads `path`'s identity, checks it against the run asked
+  /// for (CheckpointIdentity::CheckRestart), and builds the run from the rest (ConfigError naming
+  /// the file for anything that does not match or does not read).
+  static std::unique_ptr<MobilityRun> FromCheckpoint(const std::string& path, const MobilityRunParams& p,
+                                                     const std::string& scene_file,
+                                                     const std::vector<std::string>& overrides,
+                                                     CoSimLoopState* loop, CheckpointIdentity* id = nullptr);
 
  private:
   VehicleSpec spec_;  ///< read once: the terrain, the driver and the vehicle take what they need

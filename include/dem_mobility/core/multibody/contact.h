@@ -32,6 +32,7 @@ struct ContactParams {
 /// History of one contact point: where its anchor sits on the surface, and whether it was in
 /// contact at the previous step (a point out of contact loses its anchor).
 struct ContactHistory {
+  using StateBulk = void;
   Eigen::Vector3d anchor = Eigen::Vector3d::Zero();
   long last_step = -2;
 };
@@ -45,6 +46,7 @@ Eigen::Vector3d ContactForce(const ContactParams& p, const Eigen::Vector3d& poin
 
 /// Summary of a contact set's forces in the last evaluation.
 struct ContactSummary {
+  using StateBulk = void;
   Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< on the body, world
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();  ///< on the body about its COM, world
   double normal_force = 0.0;                         ///< sum of normal force magnitudes

@@ -91,6 +91,7 @@ class MultibodySystem {
   /// the work exactly, so that Energy() less the energy at Finalize less this work is what the
   /// dampers, brakes and friction took, down to the integrator's error.
   struct Work {
+    using StateBulk = void;
     double external = 0.0;  ///< ext_force and ext_torque [J]
     double sources = 0.0;   ///< AxisTorques with source = true [J]
   };
@@ -100,6 +101,11 @@ class MultibodySystem {
   /// Total mass of the movable bodies and their centre of mass.
   double TotalMass() const;
   Eigen::Vector3d CenterOfMass() const;
+  /// Its state in a checkpoint (common/state_archive.h): the bodies' motion, the elements' state
+  /// (couplings' integrals, torques, actuator targets, contact anchors), the clock and the work
+  /// ledger; the bodies and elements themselves are the built system's (their numbers are checked).
+  template <class Ar>
+  void Io(Ar& ar);
 
  private:
   /// The forces at the current state; `accumulate`: add the step's work to work_ (not at Finalize).

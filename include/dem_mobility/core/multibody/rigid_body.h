@@ -47,6 +47,12 @@ struct RigidBody {
   }
   /// Kinetic energy (translational + rotational).
   double KineticEnergy() const { return 0.5 * mass * v.squaredNorm() + 0.5 * w.dot(inertia * w); }
+  /// The state in a checkpoint (common/state_archive.h): the motion and the last step's forces and
+  /// accelerations (the parameters are the built body's).
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar(x, v, R, w, w_world, force, torque, accel, alpha, ext_force, ext_torque);
+  }
   /// Angular momentum about the COM, world frame.
   Eigen::Vector3d AngularMomentumWorld() const { return R * (inertia * w); }
 };

@@ -67,6 +67,10 @@ class LidHold {
   double mean_pressure() const { return sum_pressure_ / std::max(1L, samples_); }  ///< [Pa] over the hold
   double mean_volume() const { return area_ * sum_height_ / std::max(1L, samples_); }  ///< under the lid [m^3]
   const LidPress& press() const { return press_; }
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar(held_, sum_pressure_, sum_height_, samples_);
+  }
 
  private:
   DemSystem* s_;
@@ -108,6 +112,9 @@ class SoilPreparation {
   double height_poured() const { return height_poured_; }              ///< layer height before the lid [m]
   double height_consolidated() const { return height_consolidated_; }  ///< after the release [m]
   double lid_pressure_reached() const { return hold_ ? hold_->mean_pressure() : 0.0; }  ///< [Pa]
+  /// Its state in a checkpoint (common/state_archive.h): the phase, its steps, the lid's hold.
+  template <class Ar>
+  void Io(Ar& ar);
 
  private:
   void NextPhase(Phase next);

@@ -28,6 +28,8 @@ namespace dem_mobility::core {
 
 class ResultFile;
 class YamlReader;
+class StateReader;
+class StateWriter;
 
 /// One fidelity level of a soil bin: the particle size, the bin and the time step.
 struct SoilBinLevel {
@@ -165,6 +167,10 @@ class DemSoilBin {
   double floor_z() const { return p_.origin.z() + shift_; }
   /// Moves the soil and every wall by dz along z (the prepared surface to z = 0 under a vehicle).
   void ShiftZ(double dz);
+  /// Its state in a checkpoint (common/state_archive.h): the soil, the preparation, the tires'
+  /// centres and the energy watch.
+  template <class Ar>
+  void Io(Ar& ar);
 
  private:
   DemSoilParams p_;
@@ -194,6 +200,10 @@ class DemSoilTerrain final : public TerrainModel {
   /// Prepares the soil (pour, lid, settling); `stop` (may be empty) is called every step of it:
   /// once it returns true, Interrupted names the phase and the simulated time reached.
   DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels, const std::function<bool()>& stop = {});
+  /// The terrain of a checkpoint (common/state_archive.h): the bin built for `p` as above but not
+  /// prepared, then its soil, patch and exchange state read from `in` (ConfigError naming the
+  /// file when the checkpoint is not of this soil).
+  DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels, StateReader& in);
   /// A copy (its own particles, walls and patch): one prepared soil serves several runs.
   DemSoilTerrain(const DemSoilTerrain& o);
   DemSoilTerrain& operator=(const DemSoilTerrain&) = delete;
@@ -210,6 +220,8 @@ class DemSoilTerrain final : public TerrainModel {
   /// The grade's gravity on every particle (prepared under gravity along -z, the bed's normal: one
   /// prepared bed serves every grade; it settles under the rotated gravity with the vehicle).
   void SetGravity(const Eigen::Vector3d& g) override;
+  void SaveState(StateWriter& out) const override;
+  void LoadState(StateReader& in) override;
   const DemSoilBin& bin() const { return *bin_; }
   DemSoilBin& mutable_bin() { return *bin_; }
   /// The moving patch (nullptr without one).
@@ -219,6 +231,11 @@ class DemSoilTerrain final : public TerrainModel {
   double advance_wall_time() const { return advance_wall_; }
 
  private:
+  template <class Ar>
+  void Io(Ar& ar);
+  /// The display surface over the bin's consolidated top (with a patch, over the whole travel).
+  void MakeSurfaceMesh();
+
   std::unique_ptr<DemSoilBin> bin_;
   std::unique_ptr<SoilPatch> patch_;
   double prepare_wall_ = 0.0, advance_wall_ = 0.0;
@@ -232,6 +249,8 @@ class DemSoilTerrain final : public TerrainModel {
 std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
                                                  const std::function<bool()>& stop = {});
 TerrainDescription DescribeDemSoilTerrain(const YamlReader& y);
+/// The dem_soil terrain of a checkpoint (DemSoilTerrain's restoring constructor).
+std::unique_ptr<TerrainModel> RestoreDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle, StateReader& in);
 /// Reads and checks the bin's keys for `vehicle` as MakeDemSoilTerrain does, preparing no soil.
 void CheckDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle);
 

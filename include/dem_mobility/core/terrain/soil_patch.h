@@ -40,6 +40,7 @@ namespace dem_mobility::core {
 /// The soil in a window: bulk density of its lower three quarters and the mean top of its
 /// columns.
 struct PatchSoilMeasure {
+  using StateBulk = void;
   double density = std::numeric_limits<double>::quiet_NaN();  ///< [kg/m^3]
   double surface = std::numeric_limits<double>::quiet_NaN();  ///< [m] (scene z)
   int particles = 0;
@@ -48,6 +49,7 @@ struct PatchSoilMeasure {
 
 /// One check of the soil ahead of the front wheels (every check period once the patch follows).
 struct PatchCheck {
+  using StateBulk = void;
   double t = 0.0;                   ///< [s] the soil's time
   double front_x = 0.0;             ///< [m] the front wheels' centres (x)
   double density_ratio = 0.0;       ///< the window's bulk density over the initial bed's
@@ -79,6 +81,11 @@ struct PatchStats {
   /// or sliding on the box's floor (reported, not acted on: docs/vehicle-on-soil.md)
   double bed_slide_speed_max = 0.0;
   std::vector<PatchCheck> log;    ///< every check made, those under 90 % re-emitted soil too
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar(reemitted, strays, skipped_sites, copies, face_setback, following, initial, checks, density_ratio_mean,
+       density_ratio_min, density_ratio_max, surface_offset_mean, surface_offset_max, bed_slide_speed_max, log);
+  }
 };
 
 /// The patch's checks as CSV (t, front_x, density_ratio, surface_offset, reemitted_fraction,
@@ -112,9 +119,14 @@ class SoilPatch {
   /// two strips under the wheel tracks).
   PatchSoilMeasure Measure(double x0, double x1) const;
   int initial_particles() const { return n0_; }
+  /// Its state in a checkpoint (common/state_archive.h): the sphere, the template, the emitter's
+  /// layer, its random generator and the checks so far.
+  template <class Ar>
+  void Io(Ar& ar);
 
  private:
   struct Site {
+    using StateBulk = void;
     Eigen::Vector3d x;  ///< relative to the copy's origin (x) and the scene (y, z)
     double plastic;
   };

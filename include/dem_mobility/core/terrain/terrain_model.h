@@ -22,6 +22,8 @@ namespace dem_mobility::core {
 class YamlReader;
 class ResultFile;
 class DemSystem;
+class StateWriter;
+class StateReader;
 
 /// What a terrain shows besides its surface (the ROS layer draws it): its particles, its tools
 /// (walls, drawn at their poses) and a moving soil patch's sphere and box.
@@ -62,6 +64,10 @@ class TerrainModel {
   /// Writes the terrain's own figures into a run's result (a soil's level, f, cone index and
   /// table, the moving patch's checks); a rigid terrain has none.
   virtual void Describe(ResultFile* /*r*/) const {}
+  /// Its state in a checkpoint (common/state_archive.h), after the model built from the same file
+  /// (LoadTerrainModel) or restored (RestoreTerrainModel): a run read back steps on bit for bit.
+  virtual void SaveState(StateWriter& out) const = 0;
+  virtual void LoadState(StateReader& in) = 0;
 };
 
 /// What a terrain needs of the vehicle: its wheels' geometry.
@@ -88,6 +94,10 @@ struct TerrainKind {
   /// Reads and checks every key of the file for `vehicle` as `make` does, building nothing
   /// (no soil is prepared): ConfigError for what `make` would refuse before it starts.
   std::function<void(const YamlReader& file, const TerrainVehicle& vehicle)> check;
+  /// The model of a checkpoint, built without its preparation and read from it (empty: `make`,
+  /// then TerrainModel::LoadState: a model with nothing to prepare).
+  std::function<std::unique_ptr<TerrainModel>(const YamlReader& file, const TerrainVehicle& vehicle, StateReader& in)>
+      restore;
 };
 
 /// The terrain kinds there are.
@@ -109,5 +119,8 @@ void CheckTerrainModel(const std::string& terrain_file, const TerrainVehicle& ve
 void CheckTerrainModel(const YamlReader& terrain_file, const TerrainVehicle& vehicle);
 /// What `terrain_file` describes (model, cone index, time step, level), without building it.
 TerrainDescription DescribeTerrain(const std::string& terrain_file, const std::vector<std::string>& overrides = {});
+/// The terrain of a checkpoint: the model `terrain_file` names, its state read from `in`.
+std::unique_ptr<TerrainModel> RestoreTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
+                                                  const std::vector<std::string>& overrides, StateReader& in);
 
 }  // namespace dem_mobility::core

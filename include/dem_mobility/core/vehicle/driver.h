@@ -28,6 +28,7 @@ struct DriverParams {
 
 /// Command produced each step.
 struct DriverCommand {
+  using StateBulk = void;
   double speed_command = 0.0;   ///< [m/s]
   double torque_request = 0.0;  ///< drive-shaft torque asked for [N m] (before the engine clamp)
   double drive_torque = 0.0;    ///< after the clamp between engine-brake and WOT curves [N m]
@@ -49,6 +50,11 @@ class SpeedDriver {
   /// The steering fraction that keeps to the start line, from the lateral offset y [m, + left]
   /// and the heading [rad, + left] at forward speed v (0 when steering is off).
   double Steering(double y, double heading, double v) const;
+  /// Its state in a checkpoint (common/state_archive.h): the speed error's integral.
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar(integral_);
+  }
 
  private:
   DriverParams p_;

@@ -83,6 +83,10 @@ class Vehicle {
   /// + exchanged - (Total() - Total() at Finalize): what the dampers, brakes and differentials
   /// took. Never negative beyond the integrator's error in a stable run.
   EnergyReport Energy() const;
+  /// Its state in a checkpoint (common/state_archive.h): the multibody system, the brakes, the
+  /// requests in force and the wheels' last wrenches.
+  template <class Ar>
+  void Io(Ar& ar);
 
  private:
   friend class VehicleAssembler;
