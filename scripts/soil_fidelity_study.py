@@ -17,8 +17,10 @@ and case (grade, cone index), one run at a time by default, and writes into OUT:
 
 --runner core runs build/core's dm_run_scene instead of roslaunch: the same core loop in one
 process, without the ROS layer and without a bag (a developer's check, or a study on a machine
-where the ROS build is not wanted). A failed run is reported and the others are kept; the exit
-status is 1 if any run failed.
+where the ROS build is not wanted). Its runs keep a checkpoint (runs/<case>.ckpt, every
+--checkpoint-every wall seconds): a run that was stopped goes on from it, bit for bit, when the
+study runs again with --resume (its wall time counts the parts it ran, not the pause). A failed
+run is reported and the others are kept; the exit status is 1 if any run failed.
 """
 import argparse
 import os
@@ -60,11 +62,20 @@ def roslaunch_command(a, case, port):
 
 
 def core_command(a, case, result_file):
-    return [a.dm_run_scene, os.path.abspath(a.scene), 'grade_deg=%g' % case['grade'],
-            'terrain_overrides.fidelity=' + case['level'], 'terrain_overrides.cone_index=%g' % case['ci'],
-            'terrain_overrides.threads=%d' % a.dem_threads, 'duration=%g' % a.duration,
-            '--out', os.path.abspath(result_file),
-            '--history', os.path.abspath(result_file.replace('.result.yaml', '.history.csv'))]
+    """dm_run_scene for one case, with its checkpoint beside its result (--checkpoint-every): a run
+    that was stopped (a signal, a timeout, the machine going down) is taken up from its checkpoint,
+    bit for bit, when the case runs again (--resume)."""
+    checkpoint = os.path.abspath(result_file.replace('.result.yaml', '.ckpt'))
+    cmd = [a.dm_run_scene, os.path.abspath(a.scene), 'grade_deg=%g' % case['grade'],
+           'terrain_overrides.fidelity=' + case['level'], 'terrain_overrides.cone_index=%g' % case['ci'],
+           'terrain_overrides.threads=%d' % a.dem_threads, 'duration=%g' % a.duration,
+           '--out', os.path.abspath(result_file),
+           '--history', os.path.abspath(result_file.replace('.result.yaml', '.history.csv'))]
+    if a.checkpoint_every > 0:
+        cmd += ['--checkpoint', checkpoint, '--checkpoint-every', '%g' % a.checkpoint_every]
+        if os.path.exists(checkpoint):
+            cmd += ['--restart', checkpoint]
+    return cmd
 
 
 def check(case, result):
@@ -286,6 +297,9 @@ def main():
     ap.add_argument('--runner', choices=('roslaunch', 'core'), default='roslaunch')
     ap.add_argument('--dm-run-scene', default=os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene'))
     ap.add_argument('--resume', action='store_true', help='keep the runs whose result is already good')
+    ap.add_argument('--checkpoint-every', type=float, default=600.0,
+                    help='--runner core: wall seconds between checkpoints of a run (0: none); a run that was '
+                         'stopped goes on from its checkpoint when it runs again')
     ap.add_argument('--out', default='results/soil_fidelity')
     a = ap.parse_args()
     levels = [l for l in a.levels.split(',') if l]

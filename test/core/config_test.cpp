@@ -361,5 +361,62 @@ TEST(Config, RunnerInterruptedWhileTheSoilIsPreparedStopsWithinASecond) {
   EXPECT_FALSE(static_cast<bool>(std::getline(h, line)));
 }
 
+std::string FileText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(Config, RunnerStoppedWithACheckpointGoesOnFromItBitForBit) {
+  // a 20 s road run: whole, then sent SIGTERM after 1 s with --checkpoint (it writes the
+  // checkpoint where it stops, keeps it, and says so in its result), then taken up from it with
+  // --restart: the result and the history are those of the whole run, to the last digit
+  const fs::path dir = fs::temp_directory_path() / "dm_runner_checkpoint";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string ckpt = (dir / "run.ckpt").string(), args = "duration=20 result.end_when_steady=false";
+  const RunnerRun whole("dm_runner_ckpt_whole", "", "road_slope.yaml", args + " --checkpoint " + (dir / "w.ckpt").string());
+  ASSERT_EQ(whole.rc, 0) << whole.Err();
+  EXPECT_FALSE(fs::exists(dir / "w.ckpt"));  // the run ended: its result is what remains
+  EXPECT_GE(YAML::LoadFile(whole.result)["checkpoints_written"].as<int>(), 1);
+  const RunnerRun stopped("dm_runner_ckpt_stopped", "timeout --preserve-status -s TERM 1", "road_slope.yaml",
+                          args + " --checkpoint " + ckpt);
+  ASSERT_TRUE(WIFEXITED(stopped.rc));
+  ASSERT_EQ(WEXITSTATUS(stopped.rc), 4) << stopped.Err();
+  const YAML::Node s = YAML::LoadFile(stopped.result);
+  EXPECT_EQ(s["status"].as<std::string>(), "interrupted");
+  EXPECT_EQ(s["checkpoint"].as<std::string>(), ckpt);
+  const double at = s["checkpoint_at"].as<double>();
+  EXPECT_GT(at, 0.0);
+  EXPECT_LT(at, 20.0);
+  ASSERT_TRUE(fs::exists(ckpt));
+  const RunnerRun rest("dm_runner_ckpt_rest", "", "road_slope.yaml", args + " --restart " + ckpt + " --checkpoint " + ckpt);
+  ASSERT_EQ(rest.rc, 0) << rest.Err();
+  const YAML::Node a = YAML::LoadFile(whole.result), c = YAML::LoadFile(rest.result);
+  EXPECT_EQ(c["restarted_at"].as<double>(), at);
+  for (const char* key : {"speed_made_good", "verdict", "steps", "exchanges", "simulated_time", "drawbar_margin",
+                          "vehicle_energy_dissipated", "vehicle_energy_kinetic"})
+    EXPECT_EQ(c[key].as<std::string>(), a[key].as<std::string>()) << key;
+  EXPECT_EQ(FileText(rest.history), FileText(whole.history));  // every sample, byte for byte
+  EXPECT_FALSE(fs::exists(ckpt));
+
+  // what the runner refuses: checkpoints of a scene that is no mobility run, a period that is no
+  // number of seconds, a restart with other overrides (naming the checkpoint and what differs)
+  const RunnerRun pour("dm_runner_ckpt_pour", "", "dem_pour.yaml", "--checkpoint " + ckpt);
+  EXPECT_EQ(WEXITSTATUS(pour.rc), 1);
+  EXPECT_NE(pour.Err().find("--checkpoint and --restart are for mobility runs"), std::string::npos) << pour.Err();
+  const RunnerRun every("dm_runner_ckpt_every", "", "road_slope.yaml", "--checkpoint " + ckpt + " --checkpoint-every 0");
+  EXPECT_EQ(WEXITSTATUS(every.rc), 2);
+  EXPECT_NE(every.Err().find("--checkpoint-every 0"), std::string::npos) << every.Err();
+  const RunnerRun again("dm_runner_ckpt_again", "timeout --preserve-status -s TERM 1", "road_slope.yaml",
+                        args + " --checkpoint " + ckpt);
+  ASSERT_TRUE(fs::exists(ckpt)) << again.Err();
+  const RunnerRun other("dm_runner_ckpt_other", "", "road_slope.yaml", "duration=20 --restart " + ckpt);
+  EXPECT_EQ(WEXITSTATUS(other.rc), 1);
+  EXPECT_NE(other.Err().find(ckpt + ": checkpoint of the run of"), std::string::npos) << other.Err();
+  EXPECT_NE(other.Err().find("overrides"), std::string::npos) << other.Err();
+}
+
 }  // namespace
 }  // namespace dem_mobility::core

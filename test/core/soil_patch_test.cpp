@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -16,6 +17,7 @@
 #include <stdexcept>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/input_files.h"
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/common/yaml_reader.h"
@@ -601,6 +603,107 @@ TEST(VehicleOnSoil, RefusesBadInputNamingFileAndKey) {
   const double h = 1.2e-4;
   EXPECT_NEAR(run.dt() * run.sim().coupling_interval(), h, 1e-15);
   EXPECT_LE(run.dt(), run.sim().limit().dt_crit);
+}
+
+// A run on the moving soil patch stopped at a checkpoint and taken up again from the file is, bit
+// for bit, the run that never stopped: the particles and their contact histories, the walls' and
+// tires' candidates, the patch's sphere, emitter and random generator, the vehicle and the driver
+// all go on where they were (mobility/mobility_scene.h).
+TEST(Checkpoint, ASoilRunTakenUpAgainIsTheRunThatNeverStopped) {
+  // PreparedStrips(100)'s soil, as the scene's terrain overrides; the vehicle arrives at 6 m/s, so
+  // the patch starts to follow and re-emits soil before and after the checkpoint
+  const std::vector<std::string> o = {"grade_deg=4", "terrain_overrides.fidelity=tiny", "terrain_overrides.threads=1",
+                                      "terrain_overrides.cone_index=100", "terrain_overrides.track_strip_width=0.9",
+                                      "terrain_overrides.levels.tiny.length=" + std::to_string(kShortBox),
+                                      "terrain_overrides.patch.check_window=[0.3, 0.7]", "settle_time=0.02",
+                                      "start_speed=6", "duration=0.5", "result.end_when_steady=false"};
+  const size_t mark = InputFileCount();
+  const MobilityRunParams p = MobilityRunParams::Read(YamlReader::LoadWithOverrides(kScene, o));
+  MobilityRun whole(p, PreparedStrips(100.0));
+  const MobilityRunResult a = whole.Run();
+  ASSERT_TRUE(a.error.empty()) << a.error;
+  const auto& soil_a = dynamic_cast<const DemSoilTerrain&>(whole.terrain());
+  CheckpointIdentity id;
+  id.scene_file = std::filesystem::absolute(kScene).lexically_normal().string();
+  id.overrides = o;
+  id.files = InputFilesSince(mark);
+  id.executable = ExecutableFingerprint();
+
+  MobilityRun first(p, PreparedStrips(100.0));
+  const long at = first.sim().settle_steps() + (a.steps - first.sim().settle_steps()) / 2 + 3;
+  const std::string ckpt = ::testing::TempDir() + "checkpoint_soil.ckpt";
+  struct StopAt final : public CoSimObserver {
+    const MobilityRun* run;
+    long at;
+    std::string path;
+    CheckpointIdentity id;
+    bool stop = false;
+    long reemitted_at_stop = 0;
+    void AtStepStart(const VehicleCoSim& sim, const CoSimLoopState& st) override {
+      if (stop || sim.step() != at) return;
+      run->WriteCheckpoint(path, id, st);
+      reemitted_at_stop = dynamic_cast<const DemSoilTerrain&>(run->terrain()).patch()->stats().reemitted;
+      stop = true;
+    }
+    bool StopRequested() override { return stop; }
+  } stopper;
+  stopper.run = &first;
+  stopper.at = at;
+  stopper.path = ckpt;
+  stopper.id = id;
+  ASSERT_TRUE(first.Run(&stopper).interrupted);
+  CoSimLoopState loop;
+  std::unique_ptr<MobilityRun> rest = MobilityRun::FromCheckpoint(ckpt, p, kScene, o, &loop);
+  const MobilityRunResult c = rest->Run(nullptr, &loop);
+  ASSERT_TRUE(c.error.empty()) << c.error;
+  const auto& soil_c = dynamic_cast<const DemSoilTerrain&>(rest->terrain());
+  const PatchStats& sa = soil_a.patch()->stats();
+  std::printf("checkpoint at step %ld of %ld: re-emitted %ld before it, %ld in all; %ld soil steps\n", at, a.steps,
+              stopper.reemitted_at_stop, sa.reemitted, soil_a.bin().dem().step_count());
+  EXPECT_TRUE(sa.following);
+  EXPECT_GT(stopper.reemitted_at_stop, 50);
+  EXPECT_GT(sa.reemitted, stopper.reemitted_at_stop + 50);
+  // the vehicle's history and its end, bit for bit
+  ASSERT_EQ(c.history.size(), a.history.size());
+  for (size_t i = 0; i < a.history.size(); ++i) {
+    ASSERT_EQ(c.history[i].speed, a.history[i].speed) << "sample " << i;
+    ASSERT_EQ(c.history[i].traction, a.history[i].traction) << "sample " << i;
+    for (int w = 0; w < kWheels; ++w) ASSERT_EQ(c.history[i].sinkage[w], a.history[i].sinkage[w]) << i << " " << w;
+  }
+  EXPECT_EQ(c.steps, a.steps);
+  const Vector3d xa = whole.vehicle().ChassisFramePosition(), xc = rest->vehicle().ChassisFramePosition();
+  EXPECT_TRUE((xa.array() == xc.array()).all());
+  // every particle, the patch and the soil's ledger, bit for bit
+  const DemSystem& da = soil_a.bin().dem();
+  const DemSystem& dc = soil_c.bin().dem();
+  ASSERT_EQ(da.size(), dc.size());
+  EXPECT_EQ(da.step_count(), dc.step_count());
+  EXPECT_EQ(da.neighbour_builds(), dc.neighbour_builds());
+  const auto pa = da.positions(), pc = dc.positions(), va = da.velocities(), vc = dc.velocities();
+  long differ = 0;
+  for (size_t i = 0; i < pa.size(); ++i)
+    if (da.alive(static_cast<int>(i)) &&
+        ((pa[i].array() != pc[i].array()).any() || (va[i].array() != vc[i].array()).any()))
+      ++differ;
+  EXPECT_EQ(differ, 0);
+  const PatchStats& sc = soil_c.patch()->stats();
+  EXPECT_EQ(sc.reemitted, sa.reemitted);
+  EXPECT_EQ(sc.checks, sa.checks);
+  EXPECT_EQ(sc.log.size(), sa.log.size());
+  EXPECT_EQ(soil_c.patch()->sphere_centre().x(), soil_a.patch()->sphere_centre().x());
+  EXPECT_EQ(dc.Energy().dissipated, da.Energy().dissipated);
+
+  // a checkpoint of another soil is refused, naming what it is and what the scene asks for
+  std::vector<std::string> softer = o;
+  softer[3] = "terrain_overrides.cone_index=50";
+  try {
+    CoSimLoopState l;
+    MobilityRun::FromCheckpoint(ckpt, MobilityRunParams::Read(YamlReader::LoadWithOverrides(kScene, softer)), kScene,
+                                softer, &l);
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("overrides"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

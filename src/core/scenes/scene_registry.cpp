@@ -187,15 +187,20 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
   if (!o.checkpoint_file.empty()) {
     f.Set("checkpoints_written", progress.written());
     if (!progress.error().empty()) f.Set("checkpoint_error", progress.error());
+    // the checkpoint file holds this run: one it wrote, or the one it was taken up from
+    std::error_code ec;
+    const bool same = restart && std::filesystem::equivalent(o.restart_file, o.checkpoint_file, ec);
+    const bool holds = progress.written() > 0 || same;
+    const double at = progress.written() > 0 ? progress.last_t() : restarted.driver_time;
     const std::string status = r.Status();
     if (status == "error" || status == "interrupted") {
-      if (progress.written() > 0) {
+      if (holds) {
         f.Set("checkpoint", o.checkpoint_file);
-        f.Set("checkpoint_at", progress.last_t());
+        f.Set("checkpoint_at", at);
         std::printf("checkpoint kept: %s (t = %.3f s): --restart %s takes the run up from there\n",
-                    o.checkpoint_file.c_str(), progress.last_t(), o.checkpoint_file.c_str());
+                    o.checkpoint_file.c_str(), at, o.checkpoint_file.c_str());
       }
-    } else if (progress.written() > 0) {
+    } else if (holds) {
       std::remove(o.checkpoint_file.c_str());  // the run has ended: its result is what remains
     }
   }

@@ -656,6 +656,15 @@ template void DemSoilBin::Io(StateReader&);
 template <class Ar>
 void DemSoilTerrain::Io(Ar& ar) {
   ar.Tag("dem_soil_terrain");
+  {
+    // what soil it is (a checkpoint of another soil stops here, naming both)
+    const DemSoilParams& p = bin_->params();
+    const std::string what = detail::Concat("level ", p.level.name, ", d ", p.level.particle_diameter, " m, bin ",
+                                            p.level.length, " x ", p.level.width, " m, f ", p.cohesion_factor, ", mu ",
+                                            p.friction, ", strips ", p.strip_width, " m, patch ", p.patch.enabled,
+                                            ", seed ", p.seed);
+    ar.Tag(what.c_str());
+  }
   bin_->Io(ar);
   ar(prepare_wall_, advance_wall_, start_gap_, states_, wrenches_);
   unsigned char has_patch = patch_ ? 1 : 0;
