@@ -107,6 +107,24 @@ class Resume(unittest.TestCase):
             study.check_options(self.args(resume=True, runner='roslaunch'), self.tmp)
         self.assertIn('--runner core', str(e.exception))
 
+    def test_a_run_keeps_a_checkpoint_and_a_stopped_one_is_taken_up_from_it(self):
+        a = self.args(dm_run_scene='/bin/dm_run_scene', dem_threads=2, checkpoint_every=600.0)
+        case = {'level': 'coarse', 'grade': 0.0, 'ci': 50.0}
+        result = os.path.join(self.tmp, 'coarse_g0_ci50.result.yaml')
+        ckpt = os.path.join(self.tmp, 'coarse_g0_ci50.ckpt')
+        cmd = study.core_command(a, case, result)
+        self.assertEqual(cmd[cmd.index('--checkpoint') + 1], ckpt)
+        self.assertEqual(cmd[cmd.index('--checkpoint-every') + 1], '600')
+        self.assertNotIn('--restart', cmd)  # nothing to take up yet
+        open(ckpt, 'wb').close()
+        cmd = study.core_command(a, case, result)
+        self.assertEqual(cmd[cmd.index('--restart') + 1], ckpt)
+        # (the case's overrides are the same either way: a restart refuses other ones)
+        self.assertEqual([x for x in cmd if '=' in x], [x for x in study.core_command(
+            self.args(dm_run_scene='/bin/dm_run_scene', dem_threads=2, checkpoint_every=0.0), case, result) if '=' in x])
+        self.assertNotIn('--checkpoint', study.core_command(
+            self.args(dm_run_scene='/bin/dm_run_scene', dem_threads=2, checkpoint_every=0.0), case, result))
+
 
 if __name__ == '__main__':
     unittest.main()
