@@ -136,6 +136,9 @@ int main(int argc, char** argv) {
   } catch (const SimulationError& e) {  // (a scene that keeps no result of a failed run: the pour, the compression)
     std::cerr << "dm_run_scene: simulation error: " << e.what() << "\n";
     return 3;
+  } catch (const std::exception& e) {  // (out of memory; an internal check)
+    std::cerr << "dm_run_scene: failed: " << e.what() << "\n";
+    return 3;
   }
   return 0;
 }

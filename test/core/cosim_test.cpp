@@ -414,8 +414,16 @@ TEST(Checkpoint, ARoadRunTakenUpAgainIsTheRunThatNeverStopped) {
   refused(ckpt, {"grade_deg=12", "duration=1.5", "result.end_when_steady=false"}, "overrides");
   std::ifstream ck(ckpt, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(ck)), std::istreambuf_iterator<char>());
-  const std::string cut = WriteTemp("checkpoint_cut.ckpt", bytes.substr(0, bytes.size() / 2));
-  refused(cut, overrides, "early");
+  // cut short, or a byte changed: the checksum says so before anything is read
+  refused(WriteTemp("checkpoint_cut.ckpt", bytes.substr(0, bytes.size() / 2)), overrides, "damaged");
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 0x10;
+  refused(WriteTemp("checkpoint_flipped.ckpt", flipped), overrides, "damaged");
+  // a file whose checksum holds but whose state ends early (written by a program that wrote less)
+  std::string short_state = bytes.substr(0, bytes.size() - sizeof(uint64_t) - 100);
+  const uint64_t sum = Fnv1a(short_state.data(), short_state.size());
+  short_state.append(reinterpret_cast<const char*>(&sum), sizeof(sum));
+  refused(WriteTemp("checkpoint_short.ckpt", short_state), overrides, "early");
   std::string other = bytes;
   other[0] = 'X';
   refused(WriteTemp("checkpoint_other.ckpt", other), overrides, "not a dem_mobility checkpoint");

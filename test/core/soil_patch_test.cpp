@@ -277,6 +277,54 @@ TEST(SoilPatch, OnAGradeLaysItsFirstCopyAgainstTheSlumpedFace) {
   std::printf("bed's bottom layer: largest mean speed down the grade %.4f m/s\n", s.bed_slide_speed_max);
 }
 
+TEST(SoilPatch, ACheckpointFarAlongItsTravelIsTakenUpAgainBitForBit) {
+  // the wheels ride 1 m above the soil at 12 m/s until the sphere's rear has passed the whole bed
+  // the soil was prepared in (every particle of it re-emitted ahead): the patch of a checkpoint
+  // there is read, not measured on the bed as it is now, and the run taken up again from it is,
+  // bit for bit, the run that goes on
+  std::unique_ptr<DemSoilTerrain> t = PreparedPatch(-3.0);
+  const SoilPatch& patch = *t->patch();
+  const double h = t->description().time_step, r = t->bin().tire().radius, v = 12.0;
+  const double bed_front = patch.sphere_centre().x() + 0.5 * t->bin().params().level.length;
+  std::vector<WheelWrench> w;
+  long k = 0;
+  double x = 0.0;
+  for (; patch.sphere_centre().x() - patch.sphere_radius() < bed_front + 0.2; ++k, x += v * h) {
+    t->Synchronize(k, k * h, Wheels(x, 1.0, v, r));
+    t->GetWrenches(&w);
+    t->Advance(h);
+  }
+  std::ostringstream os(std::ios::binary);
+  StateWriter out(&os);
+  t->SaveState(out);
+  const std::string bytes = os.str();
+  std::istringstream is(bytes, std::ios::binary);
+  StateReader in(&is, "far.ckpt", bytes.size());
+  DemSoilTerrain back(t->bin().params(), t->bin().tire(), kWheels, in);
+  EXPECT_EQ(in.left(), 0u);
+  const long reemitted = patch.stats().reemitted;
+  EXPECT_GT(reemitted, t->bin().dem().num_alive());  // more than the whole bed
+  for (DemSoilTerrain* s : {t.get(), &back}) {
+    long kk = k;
+    double xx = x;
+    for (int n = 0; n < 400; ++n, ++kk, xx += v * h) {
+      s->Synchronize(kk, kk * h, Wheels(xx, 1.0, v, r));
+      s->GetWrenches(&w);
+      s->Advance(h);
+    }
+  }
+  EXPECT_GT(patch.stats().reemitted, reemitted);
+  EXPECT_EQ(back.patch()->stats().reemitted, patch.stats().reemitted);
+  EXPECT_EQ(back.patch()->stats().checks, patch.stats().checks);
+  EXPECT_EQ(back.patch()->sphere_centre().x(), patch.sphere_centre().x());
+  const auto pa = t->bin().dem().positions(), pb = back.bin().dem().positions();
+  ASSERT_EQ(pa.size(), pb.size());
+  long differ = 0;
+  for (size_t i = 0; i < pa.size(); ++i)
+    if (t->bin().dem().alive(static_cast<int>(i)) && (pa[i].array() != pb[i].array()).any()) ++differ;
+  EXPECT_EQ(differ, 0);
+}
+
 TEST(SoilPatch, RepeatsBitForBitForOneAndTwoThreadsWithTiresInTheSoil) {
   std::unique_ptr<DemSoilTerrain> a = PreparedPatch(-3.0), b = PreparedPatch(-3.0);
   b->set_threads(2);

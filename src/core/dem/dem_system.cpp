@@ -329,6 +329,7 @@ void DemSystem::Io(Ar& ar) {
   if constexpr (Ar::kLoading) {
     const size_t n = ps_.x.size();
     if (lists_.list_begin().size() != n) ar.Fail("the neighbour lists do not match the particle slots");
+    if (!walls_.Holds(static_cast<int>(n))) ar.Fail("the walls' contacts do not match the particle slots");
   }
 }
 template void DemSystem::Io(StateWriter&);

@@ -302,10 +302,35 @@ void NeighbourList::Io(Ar& ar) {
     if (nbr_.size() != hist_.size() || nbr_.size() != touching_.size()) ar.Fail("the pair lists differ in length");
     if (nbr_begin_.size() != nbr_end_.size() || nbr_begin_.size() != nbr_cap_.size())
       ar.Fail("the list bounds differ in length");
-    for (size_t i = 0; i < nbr_begin_.size(); ++i)
+    const int n = static_cast<int>(nbr_begin_.size());
+    for (int i = 0; i < n; ++i) {
       if (nbr_begin_[i] < 0 || nbr_begin_[i] > nbr_end_[i] || nbr_end_[i] > nbr_cap_[i] ||
           nbr_cap_[i] > static_cast<int>(nbr_.size()))
         ar.Fail("a list's bounds lie outside the pairs");
+      for (int k = nbr_begin_[i]; k < nbr_end_[i]; ++k)
+        if (nbr_[k] < 0 || nbr_[k] >= n) ar.Fail("a listed partner lies beyond the slots");
+    }
+    if ((grid_dims_.array() < 1).any() ||
+        static_cast<long>(cell_start_.size()) != static_cast<long>(grid_dims_.cast<long>().prod()) + 1)
+      ar.Fail("the cell grid does not match its cells");
+    for (size_t c = 0; c < cell_start_.size(); ++c)
+      if (cell_start_[c] < 0 || cell_start_[c] > n || (c > 0 && cell_start_[c] < cell_start_[c - 1]))
+        ar.Fail("a cell's slots lie beyond the slots");
+    if (slab_axis_ < 0 || slab_axis_ > 2 || cells_per_slab_ < 1 || slab_start_.size() < 2 ||
+        slab_added_.size() + 1 != slab_start_.size())
+      ar.Fail("the slabs are not slabs");
+    for (size_t s = 0; s < slab_start_.size(); ++s)
+      if (slab_start_[s] < 0 || slab_start_[s] > n || (s > 0 && slab_start_[s] < slab_start_[s - 1]))
+        ar.Fail("a slab's slots lie beyond the slots");
+    const int slabs = static_cast<int>(slab_added_.size());
+    if (static_cast<int>(slab_of_.size()) != n) ar.Fail("the slabs of the slots do not match the slots");
+    for (int s : slab_of_)
+      if (s < 0 || s >= slabs) ar.Fail("a slot's slab is not one");
+    for (const auto& added : slab_added_)
+      for (int i : added)
+        if (i < 0 || i >= n) ar.Fail("a slab's added slot lies beyond the slots");
+    for (int i : added_since_build_)
+      if (i < 0 || i >= n) ar.Fail("an added slot lies beyond the slots");
   }
 }
 template void NeighbourList::Io(StateWriter&);

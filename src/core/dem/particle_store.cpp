@@ -101,8 +101,16 @@ void ParticleStore::Io(Ar& ar) {
     for (size_t len : {v.size(), f.size(), x_built.size(), plastic.size(), adhesion_max.size(), max_repulsion.size(),
                        max_tension.size(), overlap.size(), state.size(), held.size(), id_of_slot.size()})
       if (len != n) ar.Fail("the particle arrays differ in length");
+    const int slots = static_cast<int>(n), ids = static_cast<int>(ids_.size());
     for (const IdRecord& r : ids_)
-      if (r.slot >= static_cast<int>(n)) ar.Fail("a particle's slot lies beyond the slots");
+      if (r.state > IdRecord::State::kGone || r.slot >= slots || (r.state == IdRecord::State::kLive && r.slot < 0))
+        ar.Fail("a particle's record lies beyond the slots");
+    for (size_t s = 0; s < n; ++s)
+      if (id_of_slot[s] < kNoId || id_of_slot[s] >= ids || state[s] > SlotState::kAdded)
+        ar.Fail("a slot's particle is not one");
+    for (int s : free_slots_)
+      if (s < 0 || s >= slots) ar.Fail("a free slot lies beyond the slots");
+    if (removed_ < 0 || removed_ > ids) ar.Fail("the count of removed particles is not one");
   }
 }
 template void ParticleStore::Io(StateWriter&);

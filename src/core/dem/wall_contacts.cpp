@@ -384,8 +384,22 @@ void WallContacts::Io(Ar& ar) {
       ar.Fail("the walls' vertices do not match the walls");
     for (size_t w = 0; w < vertices_.size(); ++w)
       if (vertices_[w].size() != walls_[w].mesh.vertices.size()) ar.Fail("a wall's vertices do not match its mesh");
+    for (size_t w = 0; w < built_vertices_.size(); ++w)
+      if (built_vertices_[w].size() != walls_[w].mesh.vertices.size())
+        ar.Fail("a wall's vertices at its build do not match its mesh");
+    const int T = static_cast<int>(tris_.size());
     for (int t : tri_of_slot_)
-      if (t < 0 || t >= static_cast<int>(tris_.size())) ar.Fail("a candidate triangle lies beyond the walls'");
+      if (t < 0 || t >= T) ar.Fail("a candidate triangle lies beyond the walls'");
+    for (const auto& chunk : chunk_tris_)
+      for (int t : chunk)
+        if (t < 0 || t >= T) ar.Fail("a candidate triangle lies beyond the walls'");
+    if (!tri_lo_.empty() && (tri_lo_.size() != tris_.size() || tri_hi_.size() != tris_.size()))
+      ar.Fail("the triangles' boxes do not match the triangles");
+    if (!walls_.empty() && hist_.size() % walls_.size() != 0) ar.Fail("the wall histories do not match the walls");
+    for (size_t s = 0; s < tri_start_.size(); ++s)
+      if (tri_start_[s] < 0 || tri_start_[s] > static_cast<int>(tri_of_slot_.size()) ||
+          (s > 0 && tri_start_[s] < tri_start_[s - 1]))
+        ar.Fail("a slot's candidates lie beyond the candidates");
   }
 }
 template void WallContacts::Io(StateWriter&);

@@ -1,7 +1,9 @@
 #include "dem_mobility/core/mobility/mobility_scene.h"
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "dem_mobility/core/common/error.h"
@@ -11,7 +13,8 @@
 namespace dem_mobility::core {
 
 namespace {
-// a checkpoint file: this line, the format's version, then the state (StateWriter)
+// a checkpoint file: this line, the format's version, the state (StateWriter), and the Fnv1a of
+// all the bytes before it (a damaged file is refused before anything of it is read)
 constexpr char kMagic[] = "dem_mobility checkpoint\n";
 constexpr uint32_t kFormat = 1;
 }  // namespace
@@ -30,10 +33,14 @@ void CheckpointIdentity::CheckRestart(const std::string& checkpoint, const std::
     throw ConfigError(who + "it was run with the overrides [" + was + " ], not [" + now +
                       " ]: a restart takes the same ones");
   }
+  if (executable == 0 || ExecutableFingerprint() == 0)
+    throw ConfigError(who + "the build that wrote it, or this one, could not be fingerprinted (/proc/self/exe)");
   if (executable != ExecutableFingerprint())
     throw ConfigError(who + "it was written by another build of this program: a restart must run the build that "
                             "wrote it (another may step differently)");
   for (const InputFile& f : files) {
+    if (!std::filesystem::is_regular_file(f.path, ec))
+      throw ConfigError(who + "its input file " + f.path + " is not there any more (or is not a file)");
     bool ok = false;
     const uint64_t h = FileFingerprint(f.path, &ok);
     if (!ok) throw ConfigError(who + "its input file " + f.path + " cannot be read any more");
@@ -96,7 +103,9 @@ uint64_t MobilityRun::WriteCheckpoint(const std::string& path, CheckpointIdentit
   st.r.wall_time = loop.WallTime();
   st.Io(w);
   w.Tag("end");
-  const std::string bytes = os.str();
+  std::string bytes = os.str();
+  const uint64_t sum = Fnv1a(bytes.data(), bytes.size());
+  bytes.append(reinterpret_cast<const char*>(&sum), sizeof(sum));
   WriteFileAtomically(path, bytes);
   return bytes.size();
 }
@@ -105,21 +114,27 @@ std::unique_ptr<MobilityRun> MobilityRun::FromCheckpoint(const std::string& path
                                                          const std::string& scene_file,
                                                          const std::vector<std::string>& overrides,
                                                          CoSimLoopState* loop, CheckpointIdentity* id_out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path + ": cannot open the checkpoint (missing or unreadable)");
-  in.seekg(0, std::ios::end);
-  const auto size = static_cast<uint64_t>(in.tellg());
-  in.seekg(0);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw ConfigError(path + ": cannot open the checkpoint (missing, unreadable or not a file)");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw ConfigError(path + ": cannot open the checkpoint (missing or unreadable)");
+  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
   const size_t head = sizeof(kMagic) - 1 + sizeof(kFormat);
-  std::string magic(sizeof(kMagic) - 1, '\0');
-  uint32_t format = 0;
-  if (size < head || !in.read(magic.data(), static_cast<std::streamsize>(magic.size())) || magic != kMagic)
+  if (bytes.size() < head + sizeof(uint64_t) || bytes.compare(0, sizeof(kMagic) - 1, kMagic) != 0)
     throw ConfigError(path + ": not a dem_mobility checkpoint");
-  in.read(reinterpret_cast<char*>(&format), sizeof(format));
+  uint32_t format = 0;
+  std::memcpy(&format, bytes.data() + sizeof(kMagic) - 1, sizeof(format));
   if (format != kFormat)
     throw ConfigError(path + ": checkpoint format " + std::to_string(format) + ", this program reads format " +
                       std::to_string(kFormat));
-  StateReader r(&in, path, size - head);
+  uint64_t sum = 0;
+  std::memcpy(&sum, bytes.data() + bytes.size() - sizeof(sum), sizeof(sum));
+  if (sum != Fnv1a(bytes.data(), bytes.size() - sizeof(sum)))
+    throw ConfigError(path + ": the checkpoint is damaged (its checksum does not match its bytes: cut short, or "
+                             "changed since it was written)");
+  std::istringstream in(bytes.substr(head, bytes.size() - head - sizeof(sum)), std::ios::binary);
+  StateReader r(&in, path, bytes.size() - head - sizeof(sum));
   CheckpointIdentity id;
   id.Io(r);
   id.CheckRestart(path, scene_file, overrides);

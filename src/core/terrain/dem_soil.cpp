@@ -675,10 +675,14 @@ void DemSoilTerrain::Io(Ar& ar) {
       ar.Fail(std::string("the checkpoint's soil ") + (has_patch ? "has" : "has no") + " moving patch, the scene's " +
               (p.patch.enabled ? "has one" : "has none"));
     if (!bin_->prepared()) ar.Fail("the soil in it is not prepared");
-    if (has_patch && !patch_) patch_ = std::make_unique<SoilPatch>(bin_.get(), p.patch, p.seed);
     if (wrenches_.size() != static_cast<size_t>(bin_->wheels()) ||
         (!states_.empty() && states_.size() != static_cast<size_t>(bin_->wheels())))
       ar.Fail("the wheels' states do not match the tires");
+    if (has_patch && !patch_) {
+      // (read, not measured: the restoring constructor reads every figure of the patch)
+      patch_ = std::make_unique<SoilPatch>(bin_.get(), p.patch, ar);
+      return;
+    }
   }
   if (patch_) patch_->Io(ar);
 }

@@ -83,6 +83,11 @@ SoilPatch::SoilPatch(DemSoilBin* bin, const SoilPatchParams& p, unsigned seed)
 
 SoilPatch::SoilPatch(const SoilPatch& o, DemSoilBin* bin) : SoilPatch(o) { bin_ = bin; }
 
+SoilPatch::SoilPatch(DemSoilBin* bin, const SoilPatchParams& p, StateReader& in) : bin_(bin), p_(p) {
+  DM_THROW_UNLESS(p.enabled && bin->prepared() && bin->leveling_plate() >= 0, "SoilPatch: the bin has no patch or is not prepared");
+  Io(in);
+}
+
 void SoilPatch::CaptureTemplate() {
   // the slice of the bed just behind its front wall (ahead of the front wheels and of the
   // leveling tools' reach when the patch starts to follow), as the soil is then
@@ -435,8 +440,14 @@ void SoilPatch::Io(Ar& ar) {
      layer_, free_, zone_, leaving_, prev_layer_first_id_, layer_first_id_, started_, tool_offset_, tool_z_,
      front_offset_, steps_, check_every_, bed_vx_sum_, bed_vx_count_, ratio_sum_, offset_sum_, stats_);
   if constexpr (Ar::kLoading) {
-    for (int i : layer_begin_)
-      if (i < 0 || i > static_cast<int>(sites_.size())) ar.Fail("an emitter layer lies beyond the template");
+    for (size_t k = 0; k < layer_begin_.size(); ++k)
+      if (layer_begin_[k] < 0 || layer_begin_[k] > static_cast<int>(sites_.size()) ||
+          (k > 0 && layer_begin_[k] < layer_begin_[k - 1]))
+        ar.Fail("an emitter layer lies beyond the template");
+    const int ids = bin_->dem().size();
+    if (prev_layer_first_id_ < 0 || prev_layer_first_id_ > ids || layer_first_id_ < 0 || layer_first_id_ > ids ||
+        n0_ < 0 || n0_ > ids)
+      ar.Fail("the emitter's particles lie beyond the particles");
     for (int i : free_)
       if (i < 0 || i >= static_cast<int>(sites_.size())) ar.Fail("a free site lies beyond the template");
     if (layer_ >= 0 && layer_ + 1 >= static_cast<int>(layer_begin_.size())) ar.Fail("the emitter's layer is not one");

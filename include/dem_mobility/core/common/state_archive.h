@@ -47,6 +47,12 @@ template <class T>
 struct IsPair : std::false_type {};
 template <class A, class B>
 struct IsPair<std::pair<A, B>> : std::true_type {};
+/// The fewest bytes an element of a list takes in the file (bounds a count against the file's size).
+template <class T>
+constexpr size_t MinBytes() {
+  if constexpr (IsVector<T>::value || std::is_same_v<T, std::string>) return sizeof(size_t);
+  return 1;
+}
 }  // namespace state_detail
 
 /// Whether a field is copied as its bytes.
@@ -74,7 +80,7 @@ void StateField(Ar& ar, T& v) {
     using E = typename U::value_type;
     static_assert(!std::is_same_v<E, bool>, "std::vector<bool> has no bytes to copy: use unsigned char");
     size_t n = u.size();
-    ar.Count(&n, kStateBulk<E> ? sizeof(E) : 1, "a list");
+    ar.Count(&n, kStateBulk<E> ? sizeof(E) : state_detail::MinBytes<E>(), "a list");
     if constexpr (Ar::kLoading) u.resize(n);
     if constexpr (kStateBulk<E>) {
       if (n > 0) ar.Raw(u.data(), n * sizeof(E));

@@ -112,6 +112,11 @@ class WallContacts {
   /// scene's: their number and sizes are checked.
   template <class Ar>
   void Io(Ar& ar);
+  /// Whether the per-slot arrays hold `slots` slots (a checkpoint's walls against its particles).
+  bool Holds(int slots) const {
+    return hist_.size() == static_cast<size_t>(slots) * walls_.size() && touching_.size() == hist_.size() &&
+           (tri_start_.empty() || tri_start_.size() == static_cast<size_t>(slots) + 1);
+  }
 
  private:
   struct WallTri {

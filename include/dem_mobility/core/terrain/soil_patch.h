@@ -37,6 +37,8 @@
 
 namespace dem_mobility::core {
 
+class StateReader;
+
 /// The soil in a window: bulk density of its lower three quarters and the mean top of its
 /// columns.
 struct PatchSoilMeasure {
@@ -99,6 +101,9 @@ class SoilPatch {
   SoilPatch(DemSoilBin* bin, const SoilPatchParams& p, unsigned seed);
   /// A copy bound to `bin` (a copy of the original's bin).
   SoilPatch(const SoilPatch& o, DemSoilBin* bin);
+  /// The patch of a checkpoint over `bin` (restored already): every figure read from `in`, none
+  /// measured on the bin (whose bed may have travelled far from where it was prepared).
+  SoilPatch(DemSoilBin* bin, const SoilPatchParams& p, StateReader& in);
   /// Before each DEM step, with the wheel centres at the end of that step: follows, moves the
   /// tools, re-emits what left, and checks the soil ahead every check period. SimulationError when
   /// the patch runs off the end of its floor.
