@@ -22,15 +22,22 @@ def main():
     try:
         with open(a.result) as fh:
             r = yaml.safe_load(fh)
-        load, unload = r['loading'], r['unloading']
-    except (OSError, yaml.YAMLError, KeyError, TypeError) as e:
-        sys.exit('plot_compression: cannot read %s: %s' % (a.result, e))
+        load, unload = r['loading'], r['unloading'] or []
+        poured = float(r['bulk_density_poured'])
+        # every point a (pressure, density) pair of numbers
+        load = [(float(p[0]), float(p[1])) for p in load]
+        unload = [(float(p[0]), float(p[1])) for p in unload]
+        if not load:
+            raise ValueError('no loading points')
+    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, IndexError) as e:
+        why = 'no key %s (is it the result of a uniaxial_compression scene?)' % e if isinstance(e, KeyError) else e
+        sys.exit('plot_compression: cannot read %s: %s' % (a.result, why))
     fig, ax = plt.subplots(figsize=(7, 4.5))
     ax.plot([p[0] * 1e-3 for p in load], [p[1] for p in load], 'o-', label='loading')
     if unload:
         ax.plot([load[-1][0] * 1e-3] + [p[0] * 1e-3 for p in unload], [load[-1][1]] + [p[1] for p in unload], 's--',
                 label='unloading')
-    ax.axhline(r['bulk_density_poured'], color='gray', lw=0.8, ls=':', label='poured')
+    ax.axhline(poured, color='gray', lw=0.8, ls=':', label='poured')
     if r.get('bulk_density_released'):
         ax.axhline(r['bulk_density_released'], color='k', lw=0.8, ls='-.', label='piston removed')
     ax.set_xscale('log')
@@ -41,7 +48,12 @@ def main():
     ax.legend()
     out = a.out or os.path.splitext(a.result)[0] + '.png'
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    try:
+        if os.path.dirname(out):
+            os.makedirs(os.path.dirname(out), exist_ok=True)
+        fig.savefig(out, dpi=110)
+    except OSError as e:
+        sys.exit('plot_compression: cannot write %s: %s' % (out, e))
     print('plot: %s' % out)
 
 

@@ -67,7 +67,12 @@ def main():
     ax.grid(alpha=0.3)
     ax.legend(loc='lower right', fontsize=8)
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    try:
+        if os.path.dirname(out):
+            os.makedirs(os.path.dirname(out), exist_ok=True)
+        fig.savefig(out, dpi=110)
+    except OSError as e:
+        sys.exit('plot_speed: cannot write %s: %s' % (out, e))
     print(out)
 
 
