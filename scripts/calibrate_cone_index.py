@@ -114,6 +114,10 @@ def load_finest(path):
         ref['friction'] = float(ref['friction'])
         fs, cis = [float(v) for v in ref['points']['f']], [float(v) for v in ref['points']['ci']]
         str(ref['level'])
+        if ref.get('particle_diameter') is not None:
+            ref['particle_diameter'] = float(ref['particle_diameter'])
+            if not ref['particle_diameter'] > 0:
+                raise ValueError('particle_diameter %g is not a size' % ref['particle_diameter'])
     except (TypeError, KeyError, ValueError) as e:
         raise ValueError('%s: not a finest-level file (level, friction, points.f, points.ci): %s' % (path, e))
     if len(fs) != len(cis) or not fs:
@@ -122,15 +126,21 @@ def load_finest(path):
     return ref
 
 
-def error_vs_finest(finest, ref, table, fidelity, mu):
+def error_vs_finest(finest, ref, table, fidelity, mu, diameter=None):
     """The table's relative CI error against the finest level's runs (ref: load_finest(finest)), at
-    the f values inside the table; without one, or one at another friction, a note that says so."""
+    the f values inside the table; without one, one at another friction, or one whose particles are
+    not smaller than this table's (`diameter`), a note that says so."""
     if not finest:
         return {'level': fidelity, 'note': 'only this level (%s) was run for this table: its error against a finer '
                                            'level is not known' % fidelity}
     if abs(ref['friction'] - mu) > 1e-9:
         return {'level': fidelity, 'note': 'the finest level\'s runs (%s) are at friction %g, not this table\'s %g: '
                                            'not compared' % (os.path.basename(finest), ref['friction'], mu)}
+    d_ref = ref.get('particle_diameter')
+    if diameter is not None and d_ref is not None and not d_ref < diameter - 1e-12:
+        return {'level': fidelity, 'note': 'the finest level\'s runs (%s) are of particles %g m across, not finer than '
+                                           'this table\'s %g m: not compared' % (os.path.basename(finest), d_ref,
+                                                                                  diameter)}
     fs, cis = ref['points']['f'], ref['points']['ci']
     tf, tci = [r[1] for r in table], [r[0] for r in table]
     rel = []
@@ -378,7 +388,7 @@ def main():
         if any(n > 1 for _, _, _, n in points):
             pts['ci_std'] = [round(sd, 3) if sd is not None else 0.0 for _, _, sd, _ in points]
         pts['seeds'] = [n for _, _, _, n in points]
-        err = error_vs_finest(a.finest, finest_ref, table, a.fidelity, mu)
+        err = error_vs_finest(a.finest, finest_ref, table, a.fidelity, mu, diameter)
         doc = {
             'particle_diameter': diameter,
             'friction': mu,

@@ -228,6 +228,19 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         with open(os.path.join(out, 'cone_index_mu0.1_d%g.yaml' % d)) as fh:
             self.assertIn('relative', yaml.safe_load(fh)['error_vs_finest'])
 
+    def test_a_finest_file_of_particles_no_smaller_is_not_compared(self):
+        same = os.path.join(self.tmp, 'same_size.yaml')
+        with open(same, 'w') as fh:
+            yaml.safe_dump({'level': 'tiny', 'friction': 0.1, 'particle_diameter': self.tiny['particle_diameter'],
+                            'points': {'f': [1.0], 'ci': [40.0]}}, fh)
+        out = os.path.join(self.tmp, 'same_size')
+        r = self.sweep('0.5,3', '--finest', same, out=out)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        with open(os.path.join(out, 'cone_index_mu0.1_d%g.yaml' % self.tiny['particle_diameter'])) as fh:
+            err = yaml.safe_load(fh)['error_vs_finest']
+        self.assertNotIn('relative', err)
+        self.assertIn('not finer than', err['note'])
+
     def test_a_resume_at_another_level_is_refused_naming_it(self):
         # (the runs' own results would let a kept run through the f, mu and seed checks: the
         # level's conditions and the scene's and soil's files are kept in the folder)
