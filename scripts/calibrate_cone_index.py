@@ -76,6 +76,23 @@ class Run:
         return float(self.result['cone_index_psi'])
 
 
+def write_summary(a, runs, t0, interrupted=False):
+    """OUT/sweep.yaml: every run's outcome (a run the sweep did not finish: ok false, `not run`)."""
+    doc = {'fidelity': a.fidelity, 'wall_time': round(time.time() - t0, 1), 'jobs': a.jobs, 'seeds': a.seeds}
+    if interrupted:
+        doc['interrupted'] = True
+    doc['runs'] = []
+    for r in runs:
+        done = r.outcome.done
+        ok = done and r.ok()
+        doc['runs'].append({'f': r.f, 'mu': r.mu, 'seed': r.seed, 'ok': ok,
+                            'cone_index_psi': r.ci() if ok else None,
+                            'wall_time': round((r.end or 0) - (r.start or 0), 1),
+                            'error': r.error if done else 'not run (the sweep was interrupted)', 'bag': r.bag})
+    with open(os.path.join(a.out, 'sweep.yaml'), 'w') as fh:
+        yaml.safe_dump(doc, fh, sort_keys=False)
+
+
 def mean_points(runs):
     """Per f: (f, mean CI, sample standard deviation over the seeds (None for one seed), seeds)."""
     by_f = {}
@@ -369,6 +386,8 @@ def main():
     try:
         sweep.run(t0)
     except KeyboardInterrupt:
+        # the summary of this sweep, not the one a sweep before left there
+        write_summary(a, [Run(o, a.out) for o in sweep.outcomes], t0, interrupted=True)
         sys.exit('calibrate_cone_index: interrupted; finished runs are in %s' % a.out)
     runs = [Run(o, a.out) for o in sweep.outcomes]
     fits = {}
@@ -445,13 +464,7 @@ def main():
     for p in plots(runs, a.out, a.mu, fits):
         print('plot: %s' % p)
     failed = [r for r in runs if not r.ok()]
-    with open(os.path.join(a.out, 'sweep.yaml'), 'w') as fh:
-        yaml.safe_dump({'fidelity': a.fidelity, 'wall_time': round(time.time() - t0, 1), 'jobs': a.jobs,
-                        'seeds': a.seeds,
-                        'runs': [{'f': r.f, 'mu': r.mu, 'seed': r.seed, 'ok': r.ok(),
-                                  'cone_index_psi': r.ci() if r.ok() else None,
-                                  'wall_time': round((r.end or 0) - (r.start or 0), 1),
-                                  'error': r.error, 'bag': r.bag} for r in runs]}, fh, sort_keys=False)
+    write_summary(a, runs, t0)
     print('sweep: %d runs in %.0f s, %d failed%s' % (len(runs), time.time() - t0, len(failed),
                                                     ''.join('\n  failed: %s: %s' % (r.name, r.error) for r in failed)))
     no_table = [mu for mu in a.mu if mu not in fits]

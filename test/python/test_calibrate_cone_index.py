@@ -34,7 +34,7 @@ assert sys.argv[1] == '-p' and os.environ['ROS_MASTER_URI'].endswith(':' + sys.a
 with open(os.path.join(os.path.dirname(bag), 'calls'), 'a') as fh:
     fh.write('%%g %%g %%s %%d\n' %% (f, mu, sys.argv[2], seed))
 print('[ INFO] terrain: progress: t = 0.1 s', flush=True)
-time.sleep(0.2)
+time.sleep(60 if f == 7 else 0.2)   # (f 7: a run still going when the sweep is interrupted)
 res = bag[:-4] + '.result.yaml'
 if f > 15:
     with open(res, 'w') as fh:
@@ -240,6 +240,34 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
             err = yaml.safe_load(fh)['error_vs_finest']
         self.assertNotIn('relative', err)
         self.assertIn('not finer than', err['note'])
+
+    def test_an_interrupted_sweep_leaves_its_own_summary_not_an_old_one(self):
+        import signal
+        import time
+        out = os.path.join(self.tmp, 'interrupted')
+        os.makedirs(out)
+        with open(os.path.join(out, 'sweep.yaml'), 'w') as fh:
+            fh.write('stale: a summary of an earlier sweep\n')
+        p = subprocess.Popen(
+            [sys.executable, os.path.join(ROOT, 'scripts', 'calibrate_cone_index.py'), '--fidelity', 'tiny',
+             '--f', '0.5,7', '--mu', '0.1', '--jobs', '2', '--port', '11731', '--out', out],
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, env=self.env)
+        done = os.path.join(out, 'runs', 'mu0.1_f0.5_s1.result.yaml')
+        t0 = time.time()
+        while not (os.path.exists(done) and os.path.getsize(done) > 0) and time.time() - t0 < 60:
+            time.sleep(0.2)
+        time.sleep(1.5)  # (the sweep sees the first run end)
+        p.send_signal(signal.SIGINT)
+        text = p.communicate(timeout=60)[0]
+        self.assertNotEqual(p.returncode, 0, text)
+        self.assertIn('interrupted', text)
+        with open(os.path.join(out, 'sweep.yaml')) as fh:
+            s = yaml.safe_load(fh)
+        self.assertNotIn('stale', s)
+        self.assertTrue(s['interrupted'])
+        runs = {r['f']: r for r in s['runs']}
+        self.assertTrue(runs[0.5]['ok'], runs)
+        self.assertFalse(runs[7.0]['ok'], runs)
 
     def test_a_resume_at_another_level_is_refused_naming_it(self):
         # (the runs' own results would let a kept run through the f, mu and seed checks: the
