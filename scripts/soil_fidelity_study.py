@@ -313,10 +313,16 @@ def main():
     else:
         command = lambda case, o: roslaunch_command(a, case, o.port)  # noqa: E731
     check_options(a, a.out)
-    sweep = dm_sweep.run_sweep(cases, command, os.path.join(a.out, 'runs'), resume=a.resume, accept=same_run(a),
-                               jobs=a.jobs,
-                               port=a.port, timeout=a.timeout, check=check, accept_status=STATUSES,
-                               summary=os.path.join(a.out, 'sweep.yaml'))
+    try:
+        sweep = dm_sweep.run_sweep(cases, command, os.path.join(a.out, 'runs'), resume=a.resume, accept=same_run(a),
+                                   jobs=a.jobs,
+                                   port=a.port, timeout=a.timeout, check=check, accept_status=STATUSES,
+                                   summary=os.path.join(a.out, 'sweep.yaml'))
+    except KeyboardInterrupt:  # (Ctrl-C or SIGTERM: the runs were stopped and the summary written)
+        sys.exit('soil_fidelity_study.py: interrupted; the finished runs are in %s; the same command with '
+                 '--resume goes on%s' % (os.path.join(a.out, 'runs'),
+                                         ' (a stopped run from its checkpoint)' if a.runner == 'core' and
+                                         a.checkpoint_every > 0 else ''))
     rows = summarize(sweep, a.cases)
     summary = level_summary(rows)
     with open(os.path.join(a.out, 'study.yaml'), 'w') as fh:

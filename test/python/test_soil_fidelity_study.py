@@ -125,6 +125,29 @@ class Resume(unittest.TestCase):
         self.assertNotIn('--checkpoint', study.core_command(
             self.args(dm_run_scene='/bin/dm_run_scene', dem_threads=2, checkpoint_every=0.0), case, result))
 
+    def test_a_study_stopped_by_sigterm_says_how_to_go_on_without_a_traceback(self):
+        import signal
+        import subprocess
+        import time
+        runner = os.path.join(self.tmp, 'dm_run_scene')
+        with open(runner, 'w') as fh:  # a stand-in run that takes a minute
+            fh.write('#!/bin/sh\nexec sleep 60\n')
+        os.chmod(runner, 0o755)
+        out = os.path.join(self.tmp, 'out')
+        p = subprocess.Popen([sys.executable, os.path.join(ROOT, 'scripts', 'soil_fidelity_study.py'), '--runner',
+                              'core', '--dm-run-scene', runner, '--levels', 'tiny', '--cases', '0:50', '--out', out],
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+        t0 = time.time()
+        while not os.path.exists(os.path.join(out, 'runs', 'tiny_g0_ci50.log')) and time.time() - t0 < 30:
+            time.sleep(0.1)
+        time.sleep(0.5)
+        p.send_signal(signal.SIGTERM)
+        text = p.communicate(timeout=60)[0]
+        self.assertEqual(p.returncode, 1, text)
+        self.assertNotIn('Traceback', text)
+        self.assertIn('interrupted', text)
+        self.assertIn('--resume goes on (a stopped run from its checkpoint)', text)
+
 
 if __name__ == '__main__':
     unittest.main()
