@@ -19,7 +19,8 @@ and case (grade, cone index), one run at a time by default, and writes into OUT:
 process, without the ROS layer and without a bag (a developer's check, or a study on a machine
 where the ROS build is not wanted). Its runs keep a checkpoint (runs/<case>.ckpt, every
 --checkpoint-every wall seconds): a run that was stopped goes on from it, bit for bit, when the
-study runs again with --resume (its wall time counts the parts it ran, not the pause). A failed
+study runs again with --resume (its wall time counts the parts it ran, not the pause; the log of
+each part before is kept as runs/<case>.part<N>.log). A failed
 run is reported and the others are kept; the exit status is 1 if any run failed.
 """
 import argparse
@@ -75,6 +76,13 @@ def core_command(a, case, result_file):
         cmd += ['--checkpoint', checkpoint, '--checkpoint-every', '%g' % a.checkpoint_every]
         if os.path.exists(checkpoint):
             cmd += ['--restart', checkpoint]
+            # the log of the part before is kept (the sweep writes the case's log afresh)
+            log = result_file.replace('.result.yaml', '.log')
+            if os.path.exists(log):
+                k = 1
+                while os.path.exists(log[:-4] + '.part%d.log' % k):
+                    k += 1
+                os.rename(log, log[:-4] + '.part%d.log' % k)
     return cmd
 
 

@@ -117,8 +117,14 @@ class Resume(unittest.TestCase):
         self.assertEqual(cmd[cmd.index('--checkpoint-every') + 1], '600')
         self.assertNotIn('--restart', cmd)  # nothing to take up yet
         open(ckpt, 'wb').close()
+        log = os.path.join(self.tmp, 'coarse_g0_ci50.log')
+        with open(log, 'w') as fh:
+            fh.write('the first part\n')
         cmd = study.core_command(a, case, result)
         self.assertEqual(cmd[cmd.index('--restart') + 1], ckpt)
+        # the first part's log is kept beside the one the sweep writes afresh
+        with open(os.path.join(self.tmp, 'coarse_g0_ci50.part1.log')) as fh:
+            self.assertEqual(fh.read(), 'the first part\n')
         # (the case's overrides are the same either way: a restart refuses other ones)
         self.assertEqual([x for x in cmd if '=' in x], [x for x in study.core_command(
             self.args(dm_run_scene='/bin/dm_run_scene', dem_threads=2, checkpoint_every=0.0), case, result) if '=' in x])
