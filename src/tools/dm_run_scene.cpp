@@ -3,6 +3,7 @@
 //   dm_run_scene SCENE.yaml [key=value ...] [--out RESULT.yaml] [--history HISTORY.csv] [--quiet]
 //                [--checkpoint FILE [--checkpoint-every SECONDS]] [--restart FILE]
 //   dm_run_scene SCENE.yaml [key=value ...] --check     read and check everything, run nothing
+//   dm_run_scene --checkpoint-info CHECKPOINT     what a checkpoint holds
 //   dm_run_scene --help
 // key=value overrides a scene key (dotted for nested keys: driver.kp=4000, grade_deg=12).
 // Arguments of the form __name:=value (added by roslaunch) are ignored. Exit status: 0 done, 1 bad
@@ -21,6 +22,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
+#include "dem_mobility/core/mobility/mobility_scene.h"
 #include "dem_mobility/core/scenes/scene_registry.h"
 
 using namespace dem_mobility::core;
@@ -33,6 +35,7 @@ int Usage(std::ostream& os, int status) {
   os << "usage: dm_run_scene SCENE.yaml [key=value ...] [--out RESULT.yaml] [--history HISTORY.csv] [--quiet]\n"
         "                   [--checkpoint FILE [--checkpoint-every SECONDS]] [--restart FILE]\n"
         "       dm_run_scene SCENE.yaml [key=value ...] --check\n"
+        "       dm_run_scene --checkpoint-info CHECKPOINT\n"
         "       dm_run_scene --help\n"
         "Runs a scene file of any kind (its `scene:` key) without ROS and prints its result.\n"
         "  key=value          overrides a key of the scene (dotted for nested keys: driver.kp=4000, grade_deg=12)\n"
@@ -44,6 +47,8 @@ int Usage(std::ostream& os, int status) {
         "                     SIGTERM; kept after an error or an interrupt, removed once the run has ended)\n"
         "  --restart FILE     mobility runs: takes the run up from that checkpoint, bit for bit as if it had\n"
         "                     never stopped; the same scene, overrides, input files and build are required\n"
+        "  dm_run_scene --checkpoint-info FILE   what a checkpoint holds: its scene, overrides, time, and\n"
+        "                     whether this build wrote it and its input files are unchanged\n"
         "  --check            reads and checks the scene and every file it names (vehicle, terrain, soil,\n"
         "                     calibration table), runs nothing, prepares no soil; exit 0 when all is good\n"
         "exit status: 0 done, 1 bad input (the message names file and key), 2 usage, 3 a numerical failure\n"
@@ -61,6 +66,16 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") return Usage(std::cout, 0);
   const std::string scene_file = argv[1];
+  if (scene_file == "--checkpoint-info") {
+    if (argc != 3) return Usage();
+    try {
+      std::cout << argv[2] << ":\n" << ReadCheckpointIdentity(argv[2]).Describe();
+      return 0;
+    } catch (const ConfigError& e) {
+      std::cerr << "dm_run_scene: error: " << e.what() << "\n";
+      return 1;
+    }
+  }
   if (scene_file.rfind("--", 0) == 0) return Usage();
   std::string out_file;
   bool check = false;

@@ -391,6 +391,13 @@ TEST(Config, RunnerStoppedWithACheckpointGoesOnFromItBitForBit) {
   EXPECT_GT(at, 0.0);
   EXPECT_LT(at, 20.0);
   ASSERT_TRUE(fs::exists(ckpt));
+  // what it holds, for a person
+  const Command info(std::string(DM_RUN_SCENE) + " --checkpoint-info " + ckpt);
+  EXPECT_EQ(info.status(), 0) << info.out;
+  for (const std::string& want : {std::string("scene: ") + DM_CONFIG_DIR + "/scenes/road_slope.yaml",
+                                  std::string("overrides: duration=20 result.end_when_steady=false"),
+                                  std::string("written by this build: yes"), std::string("vehicle.yaml: unchanged")})
+    EXPECT_NE(info.out.find(want), std::string::npos) << want << "\n" << info.out;
   const RunnerRun rest("dm_runner_ckpt_rest", "", "road_slope.yaml", args + " --restart " + ckpt + " --checkpoint " + ckpt);
   ASSERT_EQ(rest.rc, 0) << rest.Err();
   const YAML::Node a = YAML::LoadFile(whole.result), c = YAML::LoadFile(rest.result);

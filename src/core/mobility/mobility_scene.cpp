@@ -110,10 +110,9 @@ uint64_t MobilityRun::WriteCheckpoint(const std::string& path, CheckpointIdentit
   return bytes.size();
 }
 
-std::unique_ptr<MobilityRun> MobilityRun::FromCheckpoint(const std::string& path, const MobilityRunParams& p,
-                                                         const std::string& scene_file,
-                                                         const std::vector<std::string>& overrides,
-                                                         CoSimLoopState* loop, CheckpointIdentity* id_out) {
+namespace {
+/// The state of a checkpoint file (its header and checksum checked), as bytes.
+std::string CheckpointState(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw ConfigError(path + ": cannot open the checkpoint (missing, unreadable or not a file)");
@@ -133,8 +132,40 @@ std::unique_ptr<MobilityRun> MobilityRun::FromCheckpoint(const std::string& path
   if (sum != Fnv1a(bytes.data(), bytes.size() - sizeof(sum)))
     throw ConfigError(path + ": the checkpoint is damaged (its checksum does not match its bytes: cut short, or "
                              "changed since it was written)");
-  std::istringstream in(bytes.substr(head, bytes.size() - head - sizeof(sum)), std::ios::binary);
-  StateReader r(&in, path, bytes.size() - head - sizeof(sum));
+  return bytes.substr(head, bytes.size() - head - sizeof(sum));
+}
+}  // namespace
+
+CheckpointIdentity ReadCheckpointIdentity(const std::string& path) {
+  const std::string state = CheckpointState(path);
+  std::istringstream in(state, std::ios::binary);
+  StateReader r(&in, path, state.size());
+  CheckpointIdentity id;
+  id.Io(r);
+  return id;
+}
+
+std::string CheckpointIdentity::Describe() const {
+  std::ostringstream os;
+  os << "scene: " << scene_file << "\noverrides:";
+  for (const std::string& o : overrides) os << " " << o;
+  os << "\nat: t = " << driver_time << " s (step " << step << ")\n";
+  os << "written by this build: " << (executable == ExecutableFingerprint() ? "yes" : "no") << "\ninput files:\n";
+  for (const InputFile& f : files) {
+    bool ok = false;
+    const uint64_t h = FileFingerprint(f.path, &ok);
+    os << "  " << f.path << ": " << (!ok ? "cannot be read" : h == f.fingerprint ? "unchanged" : "CHANGED") << "\n";
+  }
+  return os.str();
+}
+
+std::unique_ptr<MobilityRun> MobilityRun::FromCheckpoint(const std::string& path, const MobilityRunParams& p,
+                                                         const std::string& scene_file,
+                                                         const std::vector<std::string>& overrides,
+                                                         CoSimLoopState* loop, CheckpointIdentity* id_out) {
+  const std::string state = CheckpointState(path);
+  std::istringstream in(state, std::ios::binary);
+  StateReader r(&in, path, state.size());
   CheckpointIdentity id;
   id.Io(r);
   id.CheckRestart(path, scene_file, overrides);

@@ -36,7 +36,13 @@ struct CheckpointIdentity {
   /// and `overrides`): another scene or overrides, an input file changed or gone, another build.
   void CheckRestart(const std::string& checkpoint, const std::string& scene_file,
                     const std::vector<std::string>& overrides) const;
+  /// What it is, for a person: the scene, the overrides, where the run was, whether this build
+  /// wrote it and whether each input file is unchanged.
+  std::string Describe() const;
 };
+
+/// The identity of the checkpoint `path` (its header and checksum checked; nothing is built).
+CheckpointIdentity ReadCheckpointIdentity(const std::string& path);
 
 class MobilityRun {
  public:
