@@ -133,9 +133,9 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
       since_ = Ticker(0.0);
     }
     void OnStep(const VehicleCoSim& sim, const DriverCommand&) override {
+      if (t0_ < 0.0) t0_ = sim.time();  // (the first step this process makes: after a restart, not 0)
       if (o_.quiet || (sim.step() & 255) != 0 || !ticker_.Due()) return;
       const double t = std::max(0.0, sim.driver_time());
-      if (t0_ < 0.0) t0_ = sim.time();
       const double rtf = (sim.time() - t0_) / std::max(ticker_.Elapsed(), 1e-9);
       std::printf("  t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s\n", t, duration_,
                   sim.vehicle().ForwardSpeed(), rtf, (duration_ - t) / std::max(rtf, 1e-9));
