@@ -10,6 +10,8 @@ import sys
 
 import matplotlib
 matplotlib.use('Agg')
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from dm_sweep.figures import save_figure  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import yaml  # noqa: E402
 
@@ -48,12 +50,7 @@ def main():
     ax.legend()
     out = a.out or os.path.splitext(a.result)[0] + '.png'
     fig.tight_layout()
-    try:
-        if os.path.dirname(out):
-            os.makedirs(os.path.dirname(out), exist_ok=True)
-        fig.savefig(out, dpi=110)
-    except OSError as e:
-        sys.exit('plot_compression: cannot write %s: %s' % (out, e))
+    save_figure(fig, out, 'plot_compression')
     print('plot: %s' % out)
 
 

@@ -11,6 +11,8 @@ import sys
 
 import matplotlib
 matplotlib.use('Agg')
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from dm_sweep.figures import save_figure  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import rosbag  # noqa: E402
 
@@ -67,12 +69,7 @@ def main():
     ax.grid(alpha=0.3)
     ax.legend(loc='lower right', fontsize=8)
     fig.tight_layout()
-    try:
-        if os.path.dirname(out):
-            os.makedirs(os.path.dirname(out), exist_ok=True)
-        fig.savefig(out, dpi=110)
-    except OSError as e:
-        sys.exit('plot_speed: cannot write %s: %s' % (out, e))
+    save_figure(fig, out, 'plot_speed')
     print(out)
 
 
