@@ -15,6 +15,12 @@
 source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_MAP_PACKAGES[@]}" "${DM_SLURM_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}" "${DM_SANITIZE_PACKAGES[@]}"
 build_core
+# The soils the tests prepare are prepared once for the whole run and read back by every other
+# test that asks for the same soil (DM_SOIL_CACHE, terrain/dem_soil.h: bit for bit the state the
+# preparation gives); a folder of this run's own, emptied first, so that every run prepares afresh.
+# The tests of the preparation itself (stopped while it runs) unset it.
+export DM_SOIL_CACHE="$DM_BUILD/soil_cache"
+rm -rf "$DM_SOIL_CACHE"
 # The core suite is CPU-bound (its tests run side by side on both cores); the stages after it
 # (builds, ROS and python tests) wait on processes, masters and a Slurm scheduler much of the
 # time. So the core suite runs in the background beside them, and its outcome is read at the end.

@@ -339,8 +339,8 @@ TEST(Config, RunnerInterruptedWhileTheSoilIsPreparedStopsWithinASecond) {
   // a soil scene (the tiny level: its preparation takes some 15-35 s here) sent SIGTERM 1 s after
   // its start, in the soil's preparation: it stops within a second of the signal (the preparation
   // polls the stop at every step), writes its result (status interrupted, the phase reached) and
-  // the history's header, and exits 4
-  const RunnerRun run("dm_runner_interrupt_prep", "timeout --preserve-status -s TERM 1", "soil_slope.yaml",
+  // the history's header, and exits 4 (without the prepared-soil cache: the soil is prepared)
+  const RunnerRun run("dm_runner_interrupt_prep", "env -u DM_SOIL_CACHE timeout --preserve-status -s TERM 1", "soil_slope.yaml",
                       "terrain_overrides.fidelity=tiny terrain_overrides.threads=1");
   ASSERT_TRUE(WIFEXITED(run.rc));
   EXPECT_EQ(WEXITSTATUS(run.rc), 4);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -752,6 +753,63 @@ TEST(Checkpoint, ASoilRunTakenUpAgainIsTheRunThatNeverStopped) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("overrides"), std::string::npos) << e.what();
   }
+}
+
+// With DM_SOIL_CACHE a prepared soil is kept and read back instead of prepared again: bit for bit
+// the soil the preparation gives (the runs on both go on alike); a damaged file is prepared again.
+TEST(Checkpoint, APreparedSoilIsKeptAndReadBackBitForBit) {
+  const std::string dir = ::testing::TempDir() + "dm_soil_cache_test";
+  std::filesystem::remove_all(dir);
+  const char* was = std::getenv("DM_SOIL_CACHE");
+  const std::string before = was ? was : "";
+  ::setenv("DM_SOIL_CACHE", dir.c_str(), 1);
+  const TerrainVehicle vehicle = TerrainVehicleOf(Hmmwv());
+  const std::vector<std::string> o = {"fidelity=tiny", "threads=1", "cone_index=80", "track_strip_width=0.9",
+                                      "levels.tiny.length=" + std::to_string(kShortBox),
+                                      "patch.check_window=[0.3, 0.7]"};
+  const auto load = [&]() {
+    std::unique_ptr<TerrainModel> m = LoadTerrainModel(kTerrain, vehicle, o);
+    std::unique_ptr<DemSoilTerrain> t(dynamic_cast<DemSoilTerrain*>(m.release()));
+    if (!t) throw std::runtime_error("not a dem_soil terrain");
+    return t;
+  };
+  std::unique_ptr<DemSoilTerrain> a = load(), b = load();
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files.push_back(e.path().string());
+  ASSERT_EQ(files.size(), 1u);
+  EXPECT_EQ(a->prepared_from(), "");
+  EXPECT_EQ(b->prepared_from(), files[0]);
+  std::printf("prepared in %.1f s, read back in %.2f s (%ld bytes)\n", a->prepare_wall_time(), b->prepare_wall_time(),
+              static_cast<long>(std::filesystem::file_size(files[0])));
+  EXPECT_LT(b->prepare_wall_time(), 0.5 * a->prepare_wall_time());
+  // the wheels roll into both soils alike
+  const double x0 = a->patch()->sphere_centre().x() + 1.0, r = a->bin().tire().radius;
+  const double z0 = a->bin().surface_height() + r;
+  for (DemSoilTerrain* t : {a.get(), b.get()}) Drive(t, x0, z0, 4.0, 300, {}, z0 - 0.04);
+  const auto pa = a->bin().dem().positions(), pb = b->bin().dem().positions();
+  ASSERT_EQ(pa.size(), pb.size());
+  long differ = 0;
+  for (size_t i = 0; i < pa.size(); ++i)
+    if (a->bin().dem().alive(static_cast<int>(i)) && (pa[i].array() != pb[i].array()).any()) ++differ;
+  EXPECT_EQ(differ, 0);
+  std::vector<WheelWrench> wa, wb;
+  a->GetWrenches(&wa);
+  b->GetWrenches(&wb);
+  double fz = 0.0;
+  for (int i = 0; i < kWheels; ++i) {
+    fz += wa[i].force.z();
+    EXPECT_TRUE((wa[i].force.array() == wb[i].force.array()).all()) << i;
+  }
+  EXPECT_GT(fz, 0.0);  // the tires were in the soil
+  // a damaged cache file: prepared again (and the file written whole again)
+  std::filesystem::resize_file(files[0], std::filesystem::file_size(files[0]) / 2);
+  std::unique_ptr<DemSoilTerrain> c = load();
+  EXPECT_EQ(c->prepared_from(), "");
+  EXPECT_EQ(load()->prepared_from(), files[0]);
+  if (was)
+    ::setenv("DM_SOIL_CACHE", before.c_str(), 1);
+  else
+    ::unsetenv("DM_SOIL_CACHE");
 }
 
 }  // namespace

@@ -257,7 +257,9 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         while not (os.path.exists(done) and os.path.getsize(done) > 0) and time.time() - t0 < 60:
             time.sleep(0.2)
         time.sleep(1.5)  # (the sweep sees the first run end)
-        p.send_signal(signal.SIGINT)
+        # (SIGTERM, as a scheduler or `kill` sends it: a test run in the background, as CI runs
+        # it, inherits SIGINT ignored)
+        p.send_signal(signal.SIGTERM)
         text = p.communicate(timeout=60)[0]
         self.assertNotEqual(p.returncode, 0, text)
         self.assertIn('interrupted', text)

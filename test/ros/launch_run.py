@@ -42,8 +42,8 @@ class LaunchRun:
         self.bag = os.path.join(self.dir, 'run.bag')
         self.result_file = self.bag[:-4] + '.result.yaml'
         self.port = free_port()
-        self.env = dict(os.environ, ROS_HOME=self.dir, ROS_MASTER_URI='http://localhost:%d' % self.port,
-                        **(env or {}))
+        env = dict(os.environ, ROS_HOME=self.dir, ROS_MASTER_URI='http://localhost:%d' % self.port, **(env or {}))
+        self.env = {k: v for k, v in env.items() if v is not None}  # (None: the variable unset)
         self.log = open(os.path.join(self.dir, 'roslaunch.log'), 'w')
         self.proc = subprocess.Popen(list(prefix) + [program, '-p', str(self.port), 'dem_mobility', launch,
                                       'bag:=' + self.bag] + list(args),

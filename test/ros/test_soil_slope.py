@@ -63,10 +63,14 @@ def tiny_scene(tmp):
 class Run(LaunchRun):
     """One roslaunch of soil_slope.launch with its own master, in its own folder."""
 
-    def __init__(self, tmp, name, *args):
+    def __init__(self, tmp, name, *args, prepare=False):
         # on a shared machine, OpenMP threads that sleep at their barriers instead of spinning keep
-        # an oversubscribed 2-thread soil from crawling (the results do not depend on it)
-        super().__init__(tmp, name, 'soil_slope.launch', *args, env={'OMP_WAIT_POLICY': 'PASSIVE'})
+        # an oversubscribed 2-thread soil from crawling (the results do not depend on it);
+        # prepare: without the prepared-soil cache (DM_SOIL_CACHE), so that the soil is prepared
+        env = {'OMP_WAIT_POLICY': 'PASSIVE'}
+        if prepare:
+            env['DM_SOIL_CACHE'] = None
+        super().__init__(tmp, name, 'soil_slope.launch', *args, env=env)
 
     def result_keys(self):
         with open(self.result_file) as f:
@@ -282,7 +286,7 @@ class Interrupted(unittest.TestCase):
             shutil.rmtree(tmp, ignore_errors=True)
 
     def stopped_in_the_preparation(self, tmp):
-        run = Run(tmp, 'prep_sigint', 'scene:=' + tiny_scene(tmp), 'dem_threads:=1', *SHORT)
+        run = Run(tmp, 'prep_sigint', 'scene:=' + tiny_scene(tmp), 'dem_threads:=1', *SHORT, prepare=True)
         time.sleep(4.0)
         self.assertIsNone(run.proc.poll(), run.output()[-3000:])
         self.assertLess(run.stop(signal.SIGINT), 3.0)

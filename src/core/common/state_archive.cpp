@@ -1,10 +1,13 @@
 #include "dem_mobility/core/common/state_archive.h"
 
+#include <dlfcn.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "dem_mobility/core/common/error.h"
@@ -98,15 +101,56 @@ uint64_t FileFingerprint(const std::string& path, bool* ok) {
 
 uint64_t ExecutableFingerprint() {
   static const uint64_t h = [] {
+    // the object this function is in: a shared library (the nodelets'), or the executable
+    std::string file = "/proc/self/exe";
+    Dl_info info;
+    if (dladdr(reinterpret_cast<void*>(&ExecutableFingerprint), &info) != 0 && info.dli_fname) {
+      const std::string f = info.dli_fname;
+      if (f.find(".so") != std::string::npos) file = f;
+    }
     bool ok = false;
-    const uint64_t f = FileFingerprint("/proc/self/exe", &ok);
+    const uint64_t f = FileFingerprint(file, &ok);
     return ok ? f : 0;
   }();
   return h;
 }
 
+std::string SealState(const std::string& magic, uint32_t format, const std::string& state) {
+  std::string bytes = magic;
+  bytes.append(reinterpret_cast<const char*>(&format), sizeof(format));
+  bytes += state;
+  const uint64_t sum = Fnv1a(bytes.data(), bytes.size());
+  bytes.append(reinterpret_cast<const char*>(&sum), sizeof(sum));
+  return bytes;
+}
+
+std::string OpenSealedState(const std::string& path, const std::string& magic, uint32_t format,
+                            const std::string& kind) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw ConfigError(path + ": cannot open the " + kind + " (missing, unreadable or not a file)");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw ConfigError(path + ": cannot open the " + kind + " (missing or unreadable)");
+  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const size_t head = magic.size() + sizeof(format);
+  if (bytes.size() < head + sizeof(uint64_t) || bytes.compare(0, magic.size(), magic) != 0)
+    throw ConfigError(path + ": not a dem_mobility " + kind);
+  uint32_t found = 0;
+  std::memcpy(&found, bytes.data() + magic.size(), sizeof(found));
+  if (found != format)
+    throw ConfigError(path + ": " + kind + " format " + std::to_string(found) + ", this program reads format " +
+                      std::to_string(format));
+  uint64_t sum = 0;
+  std::memcpy(&sum, bytes.data() + bytes.size() - sizeof(sum), sizeof(sum));
+  if (sum != Fnv1a(bytes.data(), bytes.size() - sizeof(sum)))
+    throw ConfigError(path + ": the " + kind + " is damaged (its checksum does not match its bytes: cut short, or "
+                             "changed since it was written)");
+  return bytes.substr(head, bytes.size() - head - sizeof(sum));
+}
+
 void WriteFileAtomically(const std::string& path, const std::string& bytes) {
-  const std::string tmp = path + ".writing";
+  // (a name of this process's own: two processes may write the same file at once)
+  const std::string tmp = path + ".writing." + std::to_string(::getpid());
   {
     std::FILE* f = std::fopen(tmp.c_str(), "wb");
     if (!f) throw ConfigError(path + ": cannot write the checkpoint (" + std::strerror(errno) + ")");

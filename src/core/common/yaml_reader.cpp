@@ -81,6 +81,8 @@ YamlReader YamlReader::LoadWithOverrides(const std::string& path, const std::vec
   return r;
 }
 
+std::string YamlReader::Dump() const { return YAML::Dump(node_); }
+
 YamlReader YamlReader::FromString(const std::string& text, const std::string& name) {
   YAML::Node root;
   try {

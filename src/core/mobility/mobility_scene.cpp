@@ -92,8 +92,6 @@ uint64_t MobilityRun::WriteCheckpoint(const std::string& path, CheckpointIdentit
   id.step = sim_.step();
   id.driver_time = sim_.driver_time();
   std::ostringstream os(std::ios::binary);
-  os.write(kMagic, sizeof(kMagic) - 1);
-  os.write(reinterpret_cast<const char*>(&kFormat), sizeof(kFormat));
   StateWriter w(&os);
   id.Io(w);
   terrain_->SaveState(w);
@@ -103,37 +101,14 @@ uint64_t MobilityRun::WriteCheckpoint(const std::string& path, CheckpointIdentit
   st.r.wall_time = loop.WallTime();
   st.Io(w);
   w.Tag("end");
-  std::string bytes = os.str();
-  const uint64_t sum = Fnv1a(bytes.data(), bytes.size());
-  bytes.append(reinterpret_cast<const char*>(&sum), sizeof(sum));
+  const std::string bytes = SealState(kMagic, kFormat, os.str());
   WriteFileAtomically(path, bytes);
   return bytes.size();
 }
 
 namespace {
 /// The state of a checkpoint file (its header and checksum checked), as bytes.
-std::string CheckpointState(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw ConfigError(path + ": cannot open the checkpoint (missing, unreadable or not a file)");
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw ConfigError(path + ": cannot open the checkpoint (missing or unreadable)");
-  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  const size_t head = sizeof(kMagic) - 1 + sizeof(kFormat);
-  if (bytes.size() < head + sizeof(uint64_t) || bytes.compare(0, sizeof(kMagic) - 1, kMagic) != 0)
-    throw ConfigError(path + ": not a dem_mobility checkpoint");
-  uint32_t format = 0;
-  std::memcpy(&format, bytes.data() + sizeof(kMagic) - 1, sizeof(format));
-  if (format != kFormat)
-    throw ConfigError(path + ": checkpoint format " + std::to_string(format) + ", this program reads format " +
-                      std::to_string(kFormat));
-  uint64_t sum = 0;
-  std::memcpy(&sum, bytes.data() + bytes.size() - sizeof(sum), sizeof(sum));
-  if (sum != Fnv1a(bytes.data(), bytes.size() - sizeof(sum)))
-    throw ConfigError(path + ": the checkpoint is damaged (its checksum does not match its bytes: cut short, or "
-                             "changed since it was written)");
-  return bytes.substr(head, bytes.size() - head - sizeof(sum));
-}
+std::string CheckpointState(const std::string& path) { return OpenSealedState(path, kMagic, kFormat, "checkpoint"); }
 }  // namespace
 
 CheckpointIdentity ReadCheckpointIdentity(const std::string& path) {

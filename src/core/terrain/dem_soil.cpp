@@ -1,10 +1,15 @@
 #include "dem_mobility/core/terrain/dem_soil.h"
+#include "dem_mobility/core/common/input_files.h"
 #include "dem_mobility/core/common/state_archive.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
@@ -493,6 +498,7 @@ void DemSoilTerrain::Describe(ResultFile* r) const {
   r->Set("soil_depth", bin_->surface_height() - bin_->floor_z());
   r->Set("soil_start_gap", start_gap_);
   r->Set("soil_prepare_wall_time", prepare_wall_);
+  if (!prepared_from_.empty()) r->Set("soil_prepared_from", prepared_from_);
   r->Set("soil_advance_wall_time", advance_wall_);
   r->Set("soil_steps", bin_->dem().step_count());
   r->Set("soil_neighbour_builds", bin_->dem().neighbour_builds());
@@ -623,9 +629,63 @@ DemSoilParams ReadDemSoilFor(const YamlReader& y, const TerrainVehicle& vehicle)
 }
 }  // namespace
 
+namespace {
+// a prepared soil in DM_SOIL_CACHE: this line, the format, DemSoilTerrain's state (SealState)
+const std::string kSoilMagic = "dem_mobility prepared soil\n";
+constexpr uint32_t kSoilFormat = 1;
+
+/// The cache file of a soil: named by the fingerprint of everything its preparation depends on
+/// (the terrain file with its overrides, the files its reading read, the tire, this build).
+std::string PreparedSoilPath(const std::string& dir, const YamlReader& y, const std::vector<InputFile>& files,
+                             const TerrainVehicle& vehicle) {
+  std::string key = y.Dump();
+  for (const InputFile& f : files) key += "\n" + f.path + " " + std::to_string(f.fingerprint);
+  const TriMesh& m = vehicle.tire.soil_mesh;
+  key += detail::Concat("\ntire ", vehicle.tire.radius, " ", vehicle.tire.width, " wheels ", vehicle.wheels,
+                        " track ", vehicle.track, " wheelbase ", vehicle.wheelbase, " build ", ExecutableFingerprint(),
+                        " format ", kSoilFormat);
+  uint64_t h = Fnv1a(key.data(), key.size());
+  if (!m.vertices.empty()) h = Fnv1a(m.vertices.data(), m.vertices.size() * sizeof(m.vertices[0]), h);
+  if (!m.faces.empty()) h = Fnv1a(m.faces.data(), m.faces.size() * sizeof(m.faces[0]), h);
+  char name[64];
+  std::snprintf(name, sizeof name, "soil_%016llx.prepared", static_cast<unsigned long long>(h));
+  return (std::filesystem::path(dir) / name).string();
+}
+}  // namespace
+
 std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
                                                  const std::function<bool()>& stop) {
-  return std::make_unique<DemSoilTerrain>(ReadDemSoilFor(y, vehicle), vehicle.tire, vehicle.wheels, stop);
+  const size_t mark = InputFileCount();
+  const DemSoilParams p = ReadDemSoilFor(y, vehicle);
+  const char* dir = std::getenv("DM_SOIL_CACHE");
+  if (!dir || !*dir) return std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels, stop);
+  const std::string path = PreparedSoilPath(dir, y, InputFilesSince(mark), vehicle);
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec)) {
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      const std::string state = OpenSealedState(path, kSoilMagic, kSoilFormat, "prepared soil");
+      std::istringstream in(state, std::ios::binary);
+      StateReader r(&in, path, state.size());
+      auto t = std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels, r);
+      if (r.left() != 0) r.Fail(detail::Concat(r.left(), " bytes more than the soil holds"));
+      t->SetPreparedFrom(path, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      return t;
+    } catch (const ConfigError& e) {
+      std::fprintf(stderr, "dem_soil: the prepared soil does not read (%s): preparing it again\n", e.what());
+    }
+  }
+  auto t = std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels, stop);
+  try {
+    std::filesystem::create_directories(dir, ec);
+    std::ostringstream os(std::ios::binary);
+    StateWriter w(&os);
+    t->SaveState(w);
+    WriteFileAtomically(path, SealState(kSoilMagic, kSoilFormat, os.str()));
+  } catch (const ConfigError& e) {  // (the run goes on without the cache)
+    std::fprintf(stderr, "dem_soil: the prepared soil is not kept (%s)\n", e.what());
+  }
+  return t;
 }
 
 void CheckDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle) { ReadDemSoilFor(y, vehicle); }

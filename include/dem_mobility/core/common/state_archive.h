@@ -158,8 +158,18 @@ class StateReader {
 uint64_t Fnv1a(const void* data, size_t n, uint64_t h = 0xcbf29ce484222325ULL);
 /// The fingerprint of a file's bytes; `ok` false when it cannot be read.
 uint64_t FileFingerprint(const std::string& path, bool* ok);
-/// The fingerprint of the running executable (/proc/self/exe): a restart must run the same build.
+/// The fingerprint of the build of this code that runs: the shared object it is linked into (the
+/// ROS nodelets' library), or the executable (dm_run_scene, the tests): a restart must run the
+/// same build, and a prepared soil is reused only by it. 0 when the file cannot be read.
 uint64_t ExecutableFingerprint();
+
+/// A state in a file of its own kind: `magic` (a line naming the kind), the format's version, the
+/// state's bytes, and the Fnv1a of all the bytes before it.
+std::string SealState(const std::string& magic, uint32_t format, const std::string& state);
+/// The state of a file SealState wrote; ConfigError naming `path` when it is missing, of another
+/// kind or format, or damaged (its checksum does not match).
+std::string OpenSealedState(const std::string& path, const std::string& magic, uint32_t format,
+                            const std::string& kind);
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so that a
 /// process killed while writing leaves the previous file whole; ConfigError naming the path.

@@ -66,6 +66,8 @@ class YamlReader {
   std::string FlowText(const std::string& key) const;
   /// The keys of this map, in the file's order (not marked as read).
   std::vector<std::string> Keys() const;
+  /// This map as YAML text, overrides applied (what a cache keys on; marks nothing as read).
+  std::string Dump() const;
 
   /// Resolves a path written in this file relative to the file's folder.
   std::string ResolvePath(const std::string& relative) const;

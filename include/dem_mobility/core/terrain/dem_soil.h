@@ -226,8 +226,15 @@ class DemSoilTerrain final : public TerrainModel {
   DemSoilBin& mutable_bin() { return *bin_; }
   /// The moving patch (nullptr without one).
   const SoilPatch* patch() const { return patch_.get(); }
-  /// Wall seconds spent preparing the soil and advancing it.
+  /// Wall seconds spent preparing the soil (or reading it prepared) and advancing it.
   double prepare_wall_time() const { return prepare_wall_; }
+  /// The prepared soil it was read from (PreparedSoilCache), "" when it was prepared here.
+  const std::string& prepared_from() const { return prepared_from_; }
+  /// Says that the soil was read prepared from `path` in `seconds` (not prepared here).
+  void SetPreparedFrom(const std::string& path, double seconds) {
+    prepared_from_ = path;
+    prepare_wall_ = seconds;
+  }
   double advance_wall_time() const { return advance_wall_; }
 
  private:
@@ -239,6 +246,7 @@ class DemSoilTerrain final : public TerrainModel {
   std::unique_ptr<DemSoilBin> bin_;
   std::unique_ptr<SoilPatch> patch_;
   double prepare_wall_ = 0.0, advance_wall_ = 0.0;
+  std::string prepared_from_;
   double start_gap_ = 0.0;  ///< [m] the start plane z = 0 above the bed's surface (the highest particle's top)
   TerrainDescription description_;
   TriMesh surface_mesh_;
@@ -246,6 +254,11 @@ class DemSoilTerrain final : public TerrainModel {
   std::vector<WheelWrench> wrenches_;
 };
 
+/// The dem_soil terrain of a terrain file. With the environment variable DM_SOIL_CACHE naming a
+/// folder, a soil prepared before by this build from the same file (overrides applied), soil file,
+/// calibration tables and tire is read from it instead of being prepared again (bit for bit the
+/// same state: the preparation is deterministic), and a soil prepared here is written there; the
+/// result says `soil_prepared_from`. A cached file that does not read is prepared again (a warning).
 std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
                                                  const std::function<bool()>& stop = {});
 TerrainDescription DescribeDemSoilTerrain(const YamlReader& y);
