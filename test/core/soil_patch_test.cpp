@@ -129,6 +129,16 @@ void Drive(DemSoilTerrain* t, double x0, double z, double v, long steps, const s
   }
 }
 
+/// Live particles whose positions differ, bit for bit, between two soils (of the same IDs).
+long ParticlesThatDiffer(const DemSystem& a, const DemSystem& b) {
+  const auto pa = a.positions(), pb = b.positions();
+  if (pa.size() != pb.size()) return std::max(1L, std::labs(static_cast<long>(pa.size()) - static_cast<long>(pb.size())));
+  long differ = 0;
+  for (size_t i = 0; i < pa.size(); ++i)
+    if (a.alive(static_cast<int>(i)) && (pa[i].array() != pb[i].array()).any()) ++differ;
+  return differ;
+}
+
 TEST(SoilPatch, PoursItsPartialTopLayerEvenlyAcrossTheWidth) {
   // 2.5 layers of 10 x 10 sites: the half layer on top covers both halves of the region alike
   const double d = 0.1;
@@ -318,12 +328,7 @@ TEST(SoilPatch, ACheckpointFarAlongItsTravelIsTakenUpAgainBitForBit) {
   EXPECT_EQ(back.patch()->stats().reemitted, patch.stats().reemitted);
   EXPECT_EQ(back.patch()->stats().checks, patch.stats().checks);
   EXPECT_EQ(back.patch()->sphere_centre().x(), patch.sphere_centre().x());
-  const auto pa = t->bin().dem().positions(), pb = back.bin().dem().positions();
-  ASSERT_EQ(pa.size(), pb.size());
-  long differ = 0;
-  for (size_t i = 0; i < pa.size(); ++i)
-    if (t->bin().dem().alive(static_cast<int>(i)) && (pa[i].array() != pb[i].array()).any()) ++differ;
-  EXPECT_EQ(differ, 0);
+  EXPECT_EQ(ParticlesThatDiffer(t->bin().dem(), back.bin().dem()), 0);
 }
 
 TEST(SoilPatch, RepeatsBitForBitForOneAndTwoThreadsWithTiresInTheSoil) {
@@ -343,11 +348,7 @@ TEST(SoilPatch, RepeatsBitForBitForOneAndTwoThreadsWithTiresInTheSoil) {
   Drive(b.get(), x0, z0, 5.0, 600, {}, z0 - 0.04);
   EXPECT_GT(a->patch()->stats().reemitted, 500);
   ASSERT_EQ(a->bin().dem().size(), b->bin().dem().size());
-  const auto xa = a->bin().dem().positions(), xb = b->bin().dem().positions();
-  long differ = 0;
-  for (size_t i = 0; i < xa.size(); ++i)
-    if (a->bin().dem().alive(static_cast<int>(i)) && (xa[i].array() != xb[i].array()).any()) ++differ;
-  EXPECT_EQ(differ, 0);
+  EXPECT_EQ(ParticlesThatDiffer(a->bin().dem(), b->bin().dem()), 0);
   std::vector<WheelWrench> wa, wb;
   a->GetWrenches(&wa);
   b->GetWrenches(&wb);
@@ -786,12 +787,7 @@ TEST(Checkpoint, APreparedSoilIsKeptAndReadBackBitForBit) {
   const double x0 = a->patch()->sphere_centre().x() + 1.0, r = a->bin().tire().radius;
   const double z0 = a->bin().surface_height() + r;
   for (DemSoilTerrain* t : {a.get(), b.get()}) Drive(t, x0, z0, 4.0, 300, {}, z0 - 0.04);
-  const auto pa = a->bin().dem().positions(), pb = b->bin().dem().positions();
-  ASSERT_EQ(pa.size(), pb.size());
-  long differ = 0;
-  for (size_t i = 0; i < pa.size(); ++i)
-    if (a->bin().dem().alive(static_cast<int>(i)) && (pa[i].array() != pb[i].array()).any()) ++differ;
-  EXPECT_EQ(differ, 0);
+  EXPECT_EQ(ParticlesThatDiffer(a->bin().dem(), b->bin().dem()), 0);
   std::vector<WheelWrench> wa, wb;
   a->GetWrenches(&wa);
   b->GetWrenches(&wb);
