@@ -167,6 +167,19 @@ void DemSoilParams::Describe(ResultFile* r) const {
   if (calibration) calibration->Describe(r);
 }
 
+namespace {
+/// What a dem_soil terrain of these parameters says it is.
+TerrainDescription SoilDescription(const DemSoilParams& p) {
+  TerrainDescription d;
+  d.file = p.file;
+  d.model = "dem_soil";
+  d.cone_index = p.ConeIndex();
+  d.time_step = p.level.time_step;
+  d.fidelity = p.level.name;
+  return d;
+}
+}  // namespace
+
 // ---------------------------------------------------------------------------------------------
 
 DemSoilBin::DemSoilBin(const DemSoilParams& p, const TireGeometry& tire, int wheels) : p_(p), tire_(tire) {
@@ -391,11 +404,7 @@ DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire,
                                const std::function<bool()>& stop)
     : bin_(std::make_unique<DemSoilBin>(p, tire, wheels)) {
   const auto t0 = std::chrono::steady_clock::now();
-  description_.file = p.file;
-  description_.model = "dem_soil";
-  description_.cone_index = p.ConeIndex();
-  description_.time_step = p.level.time_step;
-  description_.fidelity = p.level.name;
+  description_ = SoilDescription(p);
   while (!bin_->prepared()) {
     if (stop && stop())
       throw Interrupted(detail::Concat("interrupted while the soil (", p.file, ", level ", p.level.name, ", ",
@@ -691,14 +700,7 @@ std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const Terr
 void CheckDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle) { ReadDemSoilFor(y, vehicle); }
 
 TerrainDescription DescribeDemSoilTerrain(const YamlReader& y) {
-  const DemSoilParams p = DemSoilParams::Read(y);
-  TerrainDescription d;
-  d.file = y.file();
-  d.model = "dem_soil";
-  d.cone_index = p.ConeIndex();
-  d.time_step = p.level.time_step;
-  d.fidelity = p.level.name;
-  return d;
+  return SoilDescription(DemSoilParams::Read(y));
 }
 
 template <class Ar>
@@ -749,11 +751,7 @@ void DemSoilTerrain::Io(Ar& ar) {
 
 DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels, StateReader& in)
     : bin_(std::make_unique<DemSoilBin>(p, tire, wheels)) {
-  description_.file = p.file;
-  description_.model = "dem_soil";
-  description_.cone_index = p.ConeIndex();
-  description_.time_step = p.level.time_step;
-  description_.fidelity = p.level.name;
+  description_ = SoilDescription(p);
   wrenches_.assign(wheels, WheelWrench());
   Io(in);
   MakeSurfaceMesh();
