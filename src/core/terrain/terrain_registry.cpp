@@ -16,7 +16,7 @@ const std::vector<TerrainKind>& TerrainKinds() {
   static const std::vector<TerrainKind> kinds = {
       {"rigid_road", "a rigid polygonal road (tire vertices against its triangles, asperity friction)",
        [](const YamlReader& y, const TerrainVehicle& v, const std::function<bool()>&) { return MakeRoadTerrain(y, v); },
-       &DescribeRoadTerrain, &CheckRoadTerrain},
+       &DescribeRoadTerrain, &CheckRoadTerrain, /*restore: built by make, then its LoadState*/ nullptr},
       {"dem_soil", "a DEM soil bin (cohesive particles, prepared under a lid) the tires sink into",
        [](const YamlReader& y, const TerrainVehicle& v, const std::function<bool()>& stop) {
          return MakeDemSoilTerrain(y, v, stop);
