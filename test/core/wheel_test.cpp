@@ -320,5 +320,48 @@ TEST(SingleWheelRig, ALoadTheSoilCannotCarryIsReportedSunk) {
   EXPECT_NE(r.error().find("sank"), std::string::npos) << r.error();
 }
 
+TEST(SingleWheelRig, DrivesOfOneRestAreTheRunsTheirOwnRigsMakeBitForBit) {
+  // the load and settle phases do not depend on the drive: a towed rig's rest, driven at 30 %
+  // slip, is the run a rig at 30 % slip makes from its own preparation and rest, to the last bit
+  // (a short window at the tiny level: 0.3 m of travel)
+  const auto params = [](const std::string& drive) {
+    return SingleWheelParams::Read(YamlReader::LoadWithOverrides(
+        SceneFile(), {"fidelity=tiny", "threads=1", "wheel.drive=" + drive, "wheel.slip=0.3", "carriage.window=[0.8, 1.1]"}));
+  };
+  SingleWheelRig own(params("slip"));
+  RunSoilRig(own);
+  SingleWheelRig towed(params("towed"));
+  while (!towed.driving()) towed.Step();
+  // (not rested yet, or driven already: refused, naming the file)
+  SingleWheelRig early(params("slip"));
+  early.Step();
+  EXPECT_THROW(SingleWheelRig(early, SingleWheelParams::Drive::kSlip, 0.3, 0.0), ConfigError);
+  EXPECT_THROW(SingleWheelRig(towed, SingleWheelParams::Drive::kSlip, 1.0, 0.0), ConfigError);
+  EXPECT_THROW(SingleWheelRig(towed, SingleWheelParams::Drive::kTorque, 0.0, 2e5), ConfigError);
+  SingleWheelRig shared(towed, SingleWheelParams::Drive::kSlip, 0.3, 0.0);
+  RunSoilRig(shared);
+  EXPECT_THROW(SingleWheelRig(shared, SingleWheelParams::Drive::kSlip, 0.3, 0.0), ConfigError);
+  ASSERT_TRUE(own.done() && shared.done());
+  ASSERT_TRUE(own.error().empty() && shared.error().empty()) << own.error() << shared.error();
+  EXPECT_EQ(shared.params().drive, SingleWheelParams::Drive::kSlip);
+  ASSERT_GT(own.samples().size(), 10u);
+  ASSERT_EQ(own.samples().size(), shared.samples().size());
+  for (size_t k = 0; k < own.samples().size(); ++k) {
+    const WheelSample &a = own.samples()[k], &b = shared.samples()[k];
+    EXPECT_TRUE(a.drawbar_pull == b.drawbar_pull && a.torque == b.torque && a.sinkage == b.sinkage &&
+                a.omega == b.omega && a.vertical_force == b.vertical_force)
+        << "sample " << k << ": DP " << a.drawbar_pull << " / " << b.drawbar_pull;
+  }
+  EXPECT_EQ(own.rest_vertical_force(), shared.rest_vertical_force());
+  const auto pa = own.dem().positions(), pb = shared.dem().positions();
+  ASSERT_EQ(pa.size(), pb.size());
+  long differ = 0;
+  for (size_t i = 0; i < pa.size(); ++i) differ += (pa[i].array() != pb[i].array()).any();
+  EXPECT_EQ(differ, 0);
+  // the drive is the commanded one: the wheel turns at v / (r (1 - 0.3)) once the carriage is at speed
+  const SingleWheelParams p = params("slip");
+  EXPECT_NEAR(shared.samples().back().omega, p.speed / (p.tire.radius * 0.7), 1e-9 * p.speed / p.tire.radius);
+}
+
 }  // namespace
 }  // namespace dem_mobility::core

@@ -97,6 +97,7 @@ SingleWheelRig::SingleWheelRig(const SingleWheelParams& p, const DemSoilBin& pre
   bin_ = std::make_unique<DemSoilBin>(prepared);
   if (bin_->prepared()) {
     Place();
+    bin_->WatchEnergy(0.05);  // as Step() does once the rig's own preparation ends
     phase_ = Phase::kLoad;
   }
 }
@@ -116,6 +117,22 @@ SingleWheelRig::SingleWheelRig(const SingleWheelRig& o)
       wall0_(o.wall0_),
       prep_wall_time_(o.prep_wall_time_),
       error_(o.error_) {}
+
+SingleWheelRig::SingleWheelRig(const SingleWheelRig& rested, SingleWheelParams::Drive drive, double slip,
+                               double torque)
+    : SingleWheelRig(rested) {
+  if (phase_ != Phase::kDrive || t_phase_ != 0.0)
+    throw ConfigError(p_.file + ": a rig takes another drive only after its rest and before its first drive step (it is in '" +
+                      phase() + "')");
+  // the bounds SingleWheelParams::Read sets
+  if (!(slip >= -1.0 && slip <= 1.0) || (drive == SingleWheelParams::Drive::kSlip && slip == 1.0))
+    throw ConfigError(detail::Concat(p_.file, ": wheel.slip: ", slip, " is outside [-1, 1) (a slip drive) or [-1, 1]"));
+  if (!(torque >= -1e5 && torque <= 1e5))
+    throw ConfigError(detail::Concat(p_.file, ": wheel.torque: ", torque, " is outside [-1e5, 1e5] N m"));
+  p_.drive = drive;
+  p_.slip = slip;
+  p_.torque = torque;
+}
 
 std::string SingleWheelRig::phase() const {
   switch (phase_) {

@@ -75,6 +75,12 @@ class SingleWheelRig final : public SoilRig {
   SingleWheelRig(const SingleWheelParams& p, const DemSoilBin& prepared);
   /// A copy of the rig as it stands (its own bin): for benchmarks and what-ifs from one state.
   SingleWheelRig(const SingleWheelRig& o);
+  /// A copy of a rig that has rested under its load and not yet driven (driving(), no drive step
+  /// taken), driven as `drive`, `slip` and `torque` say: the load and settle phases do not depend
+  /// on the drive, so several drives share one rest, each the run a rig of that drive makes from
+  /// the start, bit for bit. ConfigError when `rested` has not rested, has driven already, or the
+  /// slip or torque is outside what SingleWheelParams::Read allows.
+  SingleWheelRig(const SingleWheelRig& rested, SingleWheelParams::Drive drive, double slip, double torque);
   SingleWheelRig& operator=(const SingleWheelRig&) = delete;
   /// OpenMP threads of the DEM from the next step on (results do not depend on it).
   void set_threads(int threads) { bin_->dem().set_threads(threads); }
