@@ -289,10 +289,10 @@ TEST(SoilPatch, OnAGradeLaysItsFirstCopyAgainstTheSlumpedFace) {
 }
 
 TEST(SoilPatch, ACheckpointFarAlongItsTravelIsTakenUpAgainBitForBit) {
-  // the wheels ride 1 m above the soil at 24 m/s (the top speed of a run: the patch follows at it) until the sphere's rear has passed the whole bed
-  // the soil was prepared in (every particle of it re-emitted ahead): the patch of a checkpoint
-  // there is read, not measured on the bed as it is now, and the run taken up again from it is,
-  // bit for bit, the run that goes on
+  // the wheels ride 1 m above the soil at 24 m/s (a run's top speed: the patch follows at it)
+  // until the sphere's rear has passed the whole bed the soil was prepared in (every particle of
+  // it re-emitted ahead): the patch of a checkpoint there is read, not measured on the bed as it
+  // is now, and the run taken up again from it is, bit for bit, the run that goes on
   std::unique_ptr<DemSoilTerrain> t = PreparedPatch(-3.0);
   const SoilPatch& patch = *t->patch();
   const double h = t->description().time_step, r = t->bin().tire().radius, v = 24.0;
