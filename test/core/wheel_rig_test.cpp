@@ -61,7 +61,7 @@ RigRun DriveOnce(double ci, const std::string& drive, double slip) {
   SingleWheelRig rig(Rested(ci), p.drive, p.slip, p.torque);
   RigRun r;
   while (!rig.done()) rig.Step();
-  // the soil's energy watch runs on a rig on a prepared bin too (the stability guard's ledger)
+  // the soil's energy watch runs on a rig on a prepared bin too (the ledger a run's stability is judged by)
   EXPECT_NE(rig.Report().Text().find("soil_energy_wall_work"), std::string::npos);
   r.sunk = rig.sunk();
   r.error = rig.error();
