@@ -9,6 +9,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 #include <thread>
 
 #include <nav_msgs/Odometry.h>
@@ -340,6 +342,17 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     m.cone_index_psi = r.cone_index;
     m.terrain_model = r.terrain_model;
     m.fidelity = r.terrain.fidelity;
+    // the level's error estimate, as the terrain reports it in the result file: a number, or a
+    // text saying it was not measured
+    m.speed_error_estimate = std::numeric_limits<double>::quiet_NaN();
+    if (const YAML::Node e = terrain["speed_error_estimate"]) {
+      double v = 0.0;
+      if (YAML::convert<double>::decode(e, v))
+        m.speed_error_estimate = v;
+      else
+        m.speed_error_note = e.as<std::string>();
+    }
+    if (const YAML::Node n = terrain["speed_error_note"]) m.speed_error_note = n.as<std::string>();
     m.speed_made_good = r.smg.value;
     m.speed_made_good_mph = r.smg.value / 0.44704;
     m.status = r.Status();

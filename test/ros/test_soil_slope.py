@@ -168,6 +168,9 @@ class SoilSlopeRuns(unittest.TestCase):
         self.assertEqual(len(m.slip), 4)
         self.assertEqual(m.terrain_time_step, r['soil_time_step'])
         self.assertEqual(m.cone_index_psi, 100.0)  # the cone index asked for, through the level's table
+        # the level's error estimate (tiny: measured against coarse) and how it was measured
+        self.assertEqual((m.speed_error_estimate, m.speed_error_note), (r['speed_error_estimate'], r['speed_error_note']))
+        self.assertGreater(m.speed_error_estimate, 0.0)
 
     def test_bag_holds_the_soil_and_the_vehicle(self):
         c = {t: len(v) for t, v in self.msgs.items()}
