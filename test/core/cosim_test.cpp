@@ -289,6 +289,45 @@ TEST(SpeedMadeGood, SteadyIsFlatAndQuietNotARiseAndFall) {
   EXPECT_EQ(settled.status, "steady") << settled.window_slope;
 }
 
+// Speed-made-good is the level speed with the engine at full torque for its speed (paper section
+// 4.3): a level speed below the command with the engine held back (the driver's own limit) is
+// none, a level speed at the command without full throttle is command-limited, and one at full
+// throttle is steady wherever it lies.
+TEST(SpeedMadeGood, SteadyOnlyWithTheEngineAtFullThrottle) {
+  const PlateauParams p;  // at least half the window's samples at full throttle
+  ASSERT_DOUBLE_EQ(p.full_throttle, 0.5);
+  // 9 s at 100 Hz, a flat 10 m/s with a small wobble; the command `command`; full throttle in
+  // every k-th sample of the window (k = 0: none)
+  auto history = [](double speed, double command, int k) {
+    std::vector<MobilitySample> h;
+    for (int i = 0; i <= 900; ++i) {
+      const double t = 0.01 * i;
+      h.push_back(MobilitySample{t, 0.0, speed + 0.05 * std::sin(30.0 * t), command, 0.0, 0.0, 0.0,
+                                 k > 0 && i % k == 0});
+    }
+    return h;
+  };
+  // at full throttle throughout, or in every other sample (half the window): steady at 10 m/s
+  for (int k : {1, 2}) {
+    const SpeedMadeGood s = DetectSpeedMadeGood(history(10.0, 20.0, k), p, 25.0);
+    EXPECT_EQ(s.status, "steady") << k;
+    EXPECT_NEAR(s.value, 10.0, 0.01);
+  }
+  // in every third sample (a third of the window) or never, 10 m/s under a command of 20: not yet
+  // a speed-made-good (the old detector called both steady)
+  EXPECT_EQ(DetectSpeedMadeGood(history(10.0, 20.0, 3), p, 25.0).status, "not_steady");
+  EXPECT_EQ(DetectSpeedMadeGood(history(10.0, 20.0, 0), p, 25.0).status, "not_steady");
+  // at the command's top speed (24.8 of 25 m/s) without full throttle, or with it in a third of the
+  // samples: command-limited; with it in every sample: steady there (the engine's own limit)
+  EXPECT_EQ(DetectSpeedMadeGood(history(24.8, 25.0, 0), p, 25.0).status, "command_limited");
+  EXPECT_EQ(DetectSpeedMadeGood(history(24.8, 25.0, 3), p, 25.0).status, "command_limited");
+  EXPECT_EQ(DetectSpeedMadeGood(history(24.8, 25.0, 1), p, 25.0).status, "steady");
+  // the share is the scene's: a quarter lets the every-third-sample history count
+  PlateauParams quarter = p;
+  quarter.full_throttle = 0.25;
+  EXPECT_EQ(DetectSpeedMadeGood(history(10.0, 20.0, 3), quarter, 25.0).status, "steady");
+}
+
 TEST(VehicleCoSim, EndsWhenSteadyIfAskedWithTheSpeedOfTheFullRun) {
   // the road at 20 deg: WOT-limited at about 13 m/s after ~15 s; asked to end when steady, the
   // run stops well before its 40 s with the same verdict and speed as the run that goes on

@@ -59,6 +59,7 @@ MobilityRunParams MobilityRunParams::Read(const YamlReader& y) {
   p.plateau.tolerance = res.Positive("plateau_tolerance", 0.05);
   p.plateau.scatter = res.Positive("plateau_scatter", 0.1);
   p.plateau.end_tolerance = res.Positive("plateau_end_tolerance", 0.1);
+  p.plateau.full_throttle = res.DoubleIn("plateau_full_throttle", 0.01, 1.0, 0.5);
   p.plateau.stall_speed = res.Positive("stall_speed", 0.2);
   p.plateau.stall_time = res.Positive("stall_time", 5.0);
   p.end_when_steady = res.Bool("end_when_steady", false);
@@ -110,8 +111,7 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
     return s;
   }
   // least-squares slope and mean over the trailing window
-  double n = 0, st = 0, sv = 0, stt = 0, stv = 0, svv = 0;
-  bool limited = false;
+  double n = 0, st = 0, sv = 0, stt = 0, stv = 0, svv = 0, at_wot = 0;
   for (auto it = h.rbegin(); it != h.rend() && it->t >= t_end - p.window; ++it) {
     n += 1;
     st += it->t;
@@ -119,7 +119,7 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
     stt += it->t * it->t;
     stv += it->t * it->speed;
     svv += it->speed * it->speed;
-    limited = limited || it->wot_limited;
+    at_wot += it->wot_limited ? 1 : 0;
   }
   const double mean = sv / n;
   const double var_t = stt / n - (st / n) * (st / n);
@@ -134,10 +134,14 @@ SpeedMadeGood DetectSpeedMadeGood(const std::vector<MobilitySample>& h, const Pl
   } else if (std::abs(s.window_slope) > p.tolerance || residual > p.scatter * std::abs(mean) ||
              std::abs(s.end_slope) > p.end_tolerance) {
     s.status = "not_steady";
-  } else if (!limited && mean >= 0.98 * v_max) {
+  } else if (at_wot >= p.full_throttle * n) {
+    s.status = "steady";  // level, with the engine at full torque for its speed
+  } else if (mean >= 0.98 * v_max) {
     s.status = "command_limited";
   } else {
-    s.status = "steady";
+    // level below the command with the engine held back (the driver's controller, not the
+    // vehicle, sets this speed): no speed-made-good yet
+    s.status = "not_steady";
   }
   return s;
 }

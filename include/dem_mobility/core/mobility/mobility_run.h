@@ -29,6 +29,11 @@ struct PlateauParams {
   /// [m/s^2] largest |dv/dt| over the window's trailing half (a rise and then a fall fit a flat
   /// line over the whole window: the speed must not be falling or rising at the end)
   double end_tolerance = 0.1;
+  /// the least share of the window's samples at full throttle (the driver's torque capped by the
+  /// WOT curve) for a plateau below the command to be the speed-made-good: it is the steady speed
+  /// with the engine giving all the torque it has at that speed (paper section 4.3). A plateau
+  /// with the engine held back is the driver's, not the vehicle's limit
+  double full_throttle = 0.5;
   double stall_speed = 0.2;   ///< [m/s] below this for stall_time (while the command is above it): no-go
   double stall_time = 5.0;    ///< [s]
 };
