@@ -14,6 +14,8 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/mobility/mobility_run.h"
+#include "dem_mobility/core/scenes/cone_penetrometer.h"
+#include "dem_mobility/core/terrain/dem_soil.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
@@ -248,6 +250,57 @@ TEST(Config, TheFuzzersFindingsStayFixed) {
     }
   }
   EXPECT_GT(inputs, 0) << DM_FUZZ_REGRESSIONS;
+}
+
+// A soil's strength is a cone index or a cohesion factor f. Where a file gives one and an override
+// the other, the override's takes its place (an f given on the command line to the patch, whose
+// file names CI 100, was dropped without a word before); both in one place is refused, naming the
+// file and the key.
+TEST(Config, AnOverriddenSoilStrengthTakesThePlaceOfTheFilesOther) {
+  const std::string patch = DM_CONFIG_DIR "/terrains/soil_patch.yaml";  // cone_index: 100, coarse
+  auto read = [&](const std::vector<std::string>& o) { return DemSoilParams::Read(YamlReader::LoadWithOverrides(patch, o)); };
+  // the file's CI 100 through the coarse table (the row [100, 7.5962])
+  const DemSoilParams file = read({});
+  EXPECT_DOUBLE_EQ(file.requested_ci, 100.0);
+  EXPECT_NEAR(file.cohesion_factor, 7.5962, 1e-9);
+  // f 3 by an override: f 3, no requested CI; CI 50 by an override: the table's f (2.5953)
+  const DemSoilParams f3 = read({"cohesion_factor=3"});
+  EXPECT_DOUBLE_EQ(f3.cohesion_factor, 3.0);
+  EXPECT_TRUE(std::isnan(f3.requested_ci));
+  EXPECT_NEAR(read({"cone_index=50"}).cohesion_factor, 2.5953, 1e-9);
+  // both by overrides: refused
+  try {
+    read({"cohesion_factor=3", "cone_index=50"});
+    ADD_FAILURE() << "both overridden: accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("soil_patch.yaml: cohesion_factor: and cone_index are both given by overrides"),
+              std::string::npos) << e.what();
+  }
+  // the cone scene's file gives f 1: a cone index override takes its place (coarse table, CI 50)
+  const std::string cone = DM_CONFIG_DIR "/scenes/cone_penetrometer.yaml";
+  const ConeParams c = ConeParams::Read(YamlReader::LoadWithOverrides(cone, {"fidelity=coarse", "cone_index=50"}));
+  EXPECT_NEAR(c.cohesion_factor, 2.5953, 1e-9);
+  EXPECT_DOUBLE_EQ(ConeParams::Read(YamlReader::LoadWithOverrides(cone, {"fidelity=coarse"})).cohesion_factor, 1.0);
+  // both in the file: refused (a copy of the patch's file with f added, its paths made absolute)
+  const std::string dir = ::testing::TempDir() + "/both_strengths";
+  std::filesystem::create_directories(dir);
+  std::ifstream in(patch);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string t = text.str();
+  for (const std::string& rel : {std::string("../soils/"), std::string("../calibration")}) {
+    const auto at = t.find(rel);
+    ASSERT_NE(at, std::string::npos) << rel;
+    t.replace(at, rel.size(), DM_CONFIG_DIR "/" + rel.substr(3));
+  }
+  std::ofstream(dir + "/both.yaml") << t << "cohesion_factor: 3\n";
+  try {
+    DemSoilParams::Read(YamlReader::Load(dir + "/both.yaml"));
+    ADD_FAILURE() << "both in the file: accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("both.yaml: cohesion_factor: and cone_index are both given in the file"),
+              std::string::npos) << e.what();
+  }
 }
 
 TEST(Config, SceneTerrainOverridesTakeNestedKeysAsDottedOnes) {

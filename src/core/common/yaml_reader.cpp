@@ -26,7 +26,8 @@ YamlReader::YamlReader(YAML::Node node, std::string file, std::string path)
     : node_(std::move(node)),
       file_(std::move(file)),
       path_(std::move(path)),
-      used_(std::make_shared<std::set<std::string>>()) {}
+      used_(std::make_shared<std::set<std::string>>()),
+      overridden_(std::make_shared<std::set<std::string>>()) {}
 
 YamlReader YamlReader::Load(const std::string& path) {
   // a configuration file is a regular file of modest size (a folder or a device such as /dev/zero,
@@ -61,6 +62,7 @@ YamlReader YamlReader::LoadWithOverrides(const std::string& path, const std::vec
       start = dot + 1;
     }
     parts.push_back(key.substr(start));
+    r.overridden_->insert(key);
     YAML::Node node = r.node_;
     for (size_t i = 0; i + 1 < parts.size(); ++i) {
       YAML::Node next = node[parts[i]];
@@ -108,6 +110,10 @@ bool YamlReader::Has(const std::string& key) const {
   const YAML::Node n = node_[key];
   if (n.IsDefined()) used_->insert(key);
   return n.IsDefined() && !n.IsNull();
+}
+
+bool YamlReader::Overridden(const std::string& key) const {
+  return overridden_->count(path_.empty() ? key : path_ + "." + key) > 0;
 }
 
 YAML::Node YamlReader::Get(const std::string& key) const {
@@ -250,7 +256,9 @@ std::string YamlReader::FlowText(const std::string& key) const {
 YamlReader YamlReader::Child(const std::string& key) const {
   const YAML::Node n = Get(key);
   if (!n.IsMap()) Fail(key, "expected a map of keys, found " + Show(n));
-  return YamlReader(n, file_, path_.empty() ? key : path_ + "." + key);
+  YamlReader child(n, file_, path_.empty() ? key : path_ + "." + key);
+  child.overridden_ = overridden_;
+  return child;
 }
 
 std::string YamlReader::ResolvePath(const std::string& relative) const {

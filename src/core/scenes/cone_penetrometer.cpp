@@ -50,10 +50,10 @@ ConeParams ConeParams::Read(const YamlReader& y) {
   p.level = ReadFidelityLevel<ConeLevel>(y, ReadLevel);  // every level checked, the named one used
   // the soil: f directly, or from a requested cone index through a calibration table
   // (through the table of the level's particle size and the friction: CI(f) depends on both)
-  const double f_file = y.Has("cohesion_factor") ? y.Double("cohesion_factor") : 1.0;
   p.friction = y.DoubleIn("friction", 0.0, 2.0);
   if (y.Has("calibration")) p.calibration_file = y.ResolvePath(y.String("calibration"));
-  if (y.Has("cone_index")) {
+  const bool by_ci = SoilStrengthByConeIndex(y);  // (the one an override gives, where both are there)
+  if (by_ci) {
     p.requested_ci = y.Positive("cone_index");
     if (p.calibration_file.empty()) y.Fail("calibration", "is needed to turn cone_index into f");
     try {
@@ -64,10 +64,10 @@ ConeParams ConeParams::Read(const YamlReader& y) {
     }
   } else {
     if (!y.Has("cohesion_factor")) y.Fail("cohesion_factor", "is not set (nor is cone_index)");
-    p.cohesion_factor = f_file;
+    p.cohesion_factor = y.Double("cohesion_factor");
   }
   if (!(p.cohesion_factor >= kMinCohesionFactor && p.cohesion_factor <= kMaxCohesionFactor))
-    y.Fail(y.Has("cone_index") ? "cone_index" : "cohesion_factor",
+    y.Fail(by_ci ? "cone_index" : "cohesion_factor",
            "the cohesion factor f = " + detail::Concat(p.cohesion_factor) + " lies outside the paper's range [" +
                detail::Concat(kMinCohesionFactor) + ", " + detail::Concat(kMaxCohesionFactor) + "]");
   p.soil.diameter = p.level.particle_diameter;

@@ -54,8 +54,8 @@ DemSoilParams DemSoilParams::Read(const YamlReader& y) {
   // the soil: f directly, or from a requested cone index through the calibration table made at
   // this level's particle size
   if (y.Has("calibration")) p.calibration_file = y.ResolvePath(y.String("calibration"));
-  if (y.Has("cone_index")) {  // (it takes the place of a cohesion_factor in the file)
-    if (y.Has("cohesion_factor")) y.Double("cohesion_factor");
+  const bool by_ci = SoilStrengthByConeIndex(y);  // (the one an override gives, where both are there)
+  if (by_ci) {
     p.requested_ci = y.Positive("cone_index");
     if (p.calibration_file.empty()) y.Fail("calibration", "is needed to turn cone_index into f");
     try {
@@ -80,7 +80,7 @@ DemSoilParams DemSoilParams::Read(const YamlReader& y) {
     }
   }
   if (!(p.cohesion_factor >= kMinCohesionFactor && p.cohesion_factor <= kMaxCohesionFactor))
-    y.Fail(y.Has("cone_index") ? "cone_index" : "cohesion_factor",
+    y.Fail(by_ci ? "cone_index" : "cohesion_factor",
            "the cohesion factor f = " + detail::Concat(p.cohesion_factor) + " lies outside the paper's range [" +
                detail::Concat(kMinCohesionFactor) + ", " + detail::Concat(kMaxCohesionFactor) + "]");
   p.soil.diameter = p.level.particle_diameter;

@@ -38,6 +38,8 @@ class YamlReader {
   YamlReader(YAML::Node node, std::string file, std::string path);
 
   bool Has(const std::string& key) const;
+  /// Whether `key` of this map was set by an override of LoadWithOverrides (not marked as read).
+  bool Overridden(const std::string& key) const;
   double Double(const std::string& key) const;
   double Double(const std::string& key, double fallback) const;
   /// A double that must lie in [lo, hi].
@@ -91,6 +93,8 @@ class YamlReader {
   std::string file_;
   std::string path_;
   std::shared_ptr<std::set<std::string>> used_;
+  /// the dotted key paths the overrides set (shared by the document's readers)
+  std::shared_ptr<std::set<std::string>> overridden_;
 };
 
 /// Opens a configuration file by its path: YamlReader::Load, or (the fuzz harnesses) text given in
