@@ -269,24 +269,38 @@ def plot_histories(runs_dir, names, path):
     return path
 
 
-def plot(rows, path):
+def plot(rows, path, unfinished=()):
+    """Speed-made-good against wall time, a line per case; `unfinished`: runs stopped before their
+    verdict (rows with grade, cone_index, level, wall_time and the speed reached, speed_reached),
+    drawn as open markers with an arrow up: the speed-made-good is at least that, the wall time
+    more than that."""
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    for key in sorted({(r['grade'], r['cone_index']) for r in rows}):
+    for key in sorted({(r['grade'], r['cone_index']) for r in list(rows) + list(unfinished)}):
         rs = [r for r in rows if (r['grade'], r['cone_index']) == key]
-        ax.plot([r['wall_time'] for r in rs], [r['speed_made_good'] for r in rs], 'o-',
-                label='%g deg, CI %g psi' % key)
+        line, = ax.plot([r['wall_time'] for r in rs], [r['speed_made_good'] for r in rs], 'o-',
+                        label='%g deg, CI %g psi' % key)
         for r in rs:
             ax.annotate(r['level'] + (' (ref)' if r['level'] == r['reference'] else ''),
                         (r['wall_time'], r['speed_made_good']), textcoords='offset points', xytext=(5, 5), fontsize=8)
+        for u in [u for u in unfinished if (u['grade'], u['cone_index']) == key]:
+            x, y = u['wall_time'], u['speed_reached']
+            if rs:  # (dotted: the case's line to a bound, not to a value)
+                ax.plot([rs[-1]['wall_time'], x], [rs[-1]['speed_made_good'], y], ':', color=line.get_color())
+            ax.plot([x], [y], 'o', mfc='none', color=line.get_color())
+            ax.annotate('', xy=(x, y + 1.5), xytext=(x, y), arrowprops=dict(arrowstyle='->', color=line.get_color()))
+            ax.annotate('%s: not finished, >= %.1f m/s\n(%.1f s driven, still rising)' % (u['level'], y, u['simulated_time']),
+                        (x, y), textcoords='offset points', xytext=(-125, -4), fontsize=8)
+            lo, hi = ax.get_ylim()
+            ax.set_ylim(lo, max(hi, y + 2.0))
     ax.set_xscale('log')
     ax.set_xlabel('wall time of the run, preparation included [s] (2-core machine)')
     ax.set_ylabel('speed-made-good [m/s]')
     ax.set_title('Speed-made-good against run time per fidelity level')
     ax.grid(True, which='both', alpha=0.3)
-    ax.legend()
+    ax.legend(loc='lower right')
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 

@@ -10,7 +10,9 @@ preparation dominates):
   time), the patch tools, the wheel exchanges, the force arrows and speed label; plot_speed.py
   draws it, and the topics of rviz/soil_slope.rviz are its topics;
 - the soil on 1 and on 2 threads gives the same bag, message for message (the result message but
-  for its wall time);
+  for its wall time), and so does the same run made again (its soil prepared afresh);
+- replay.launch plays the bag back: a recorder on the replay gets every message of the run's
+  topics, byte for byte;
 - a cone index outside the calibration table is refused naming the terrain file and the key;
 - Ctrl-C (SIGINT) while the soil is being prepared stops the run at once: an `interrupted` result,
   a closed bag.
@@ -32,7 +34,9 @@ import unittest
 import numpy as np
 import yaml
 
-from launch_run import LaunchRun  # beside this file
+import rosbag
+
+from launch_run import LaunchRun, free_port, stop_group  # beside this file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -92,6 +96,9 @@ class SoilSlopeRuns(unittest.TestCase):
         t2 = Run(cls.tmp, 't2', 'scene:=' + cls.scene, 'dem_threads:=2', *SHORT)
         cls.core_err = cls.core.communicate(timeout=600)[1]
         cls.t2 = t2.wait(600)
+        # the first run made again as it was, its soil prepared again (not read from the cache)
+        cls.t1_again = Run(cls.tmp, 't1_again', 'scene:=' + cls.scene, 'dem_threads:=1', *SHORT,
+                           prepare=True).wait(600)
         cls.res = cls.t1.result()
         cls.msgs = {}
         for topic, m, _ in cls.t1.messages():
@@ -243,8 +250,8 @@ class SoilSlopeRuns(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertGreater(os.path.getsize(out), 10000)
 
-    def test_one_and_two_soil_threads_give_the_same_bag(self):
-        a, b = self.t1.messages(raw=True), self.t2.messages(raw=True)
+    def assert_same_bag(self, other):
+        a, b = self.t1.messages(raw=True), other.messages(raw=True)
         self.assertGreater(len(a), 200)
         self.assertEqual([t for t, _, _ in a], [t for t, _, _ in b])
         for (ta, da, sa), (_, db, sb) in zip(a, b):
@@ -252,7 +259,7 @@ class SoilSlopeRuns(unittest.TestCase):
             if ta == NS + 'result':
                 continue  # holds the wall time; compared below without it
             self.assertEqual(da, db, 'message on %s at %s differs' % (ta, sa))
-        ma, mb = self.msgs[NS + 'result'][0], [m for t, m, _ in self.t2.messages() if t == NS + 'result'][0]
+        ma, mb = self.msgs[NS + 'result'][0], [m for t, m, _ in other.messages() if t == NS + 'result'][0]
         for f in ma.__slots__:
             if f not in ('wall_time', 'real_time_factor'):
                 va, vb = getattr(ma, f), getattr(mb, f)
@@ -260,6 +267,61 @@ class SoilSlopeRuns(unittest.TestCase):
                     self.assertTrue(math.isnan(vb), f)
                 else:
                     self.assertEqual(va, vb, f)
+
+    def test_one_and_two_soil_threads_give_the_same_bag(self):
+        self.assert_same_bag(self.t2)
+
+    def test_the_same_run_made_again_gives_the_same_bag(self):
+        self.assertEqual(self.t1_again.proc.returncode, 0, self.t1_again.output()[-3000:])
+        self.assertEqual(self.t1_again.result()['error'], '')
+        self.assert_same_bag(self.t1_again)
+
+    def test_replay_plays_every_message_of_the_run_back(self):
+        # replay.launch (no rviz) on the run's bag, on a master the test starts, with `rosbag record`
+        # of the run's topics subscribed to all of them before the replay starts (and play waiting
+        # 2 s after advertising, for it to connect): the recording holds every message of those
+        # topics, the same bytes in the same order
+        topics = [NS + t for t in ('terrain/particles', 'terrain/tools', 'odom', 'wheel_states', 'wheel_wrenches',
+                                   'vehicle/forces', 'result')] + ['/tf']
+        d = os.path.join(self.tmp, 'replay')
+        os.makedirs(d)
+        port = free_port()
+        env = dict(os.environ, ROS_HOME=d, ROS_MASTER_URI='http://localhost:%d' % port)
+        out = os.path.join(d, 'replayed.bag')
+        master = subprocess.Popen(['rosmaster', '--core', '-p', str(port)], stdout=subprocess.DEVNULL,
+                                  stderr=subprocess.STDOUT, env=env, start_new_session=True)
+        record = launch = None
+        try:
+            def until(what, ok, timeout=60):
+                deadline = time.time() + timeout
+                while not ok():
+                    self.assertLess(time.time(), deadline, 'no %s within %d s' % (what, timeout))
+                    time.sleep(0.2)
+            until('master', lambda: subprocess.run(['rosnode', 'list'], env=env, capture_output=True).returncode == 0)
+            record = subprocess.Popen(['rosbag', 'record', '-O', out] + topics, stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.STDOUT, env=env, start_new_session=True)
+            until('recorder on every topic', lambda: all('/record' in subprocess.run(
+                ['rostopic', 'info', t], env=env, capture_output=True, text=True).stdout for t in topics))
+            launch = subprocess.Popen(['roslaunch', 'dem_mobility', 'replay.launch', 'bag:=' + self.t1.bag,
+                                       'rviz:=false', 'delay:=2'], stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.STDOUT, env=env, start_new_session=True)
+            launch.wait(120)
+            self.assertEqual(launch.returncode, 0)
+            time.sleep(1.0)
+        finally:
+            for p in (record, launch, master):
+                if p is not None:
+                    stop_group(p)
+        with rosbag.Bag(out) as b:
+            replayed = [(t, m[1]) for t, m, _ in b.read_messages(raw=True)]  # (topic, serialized bytes)
+        original = [(t, m) for t, m, _ in self.t1.messages(topics=topics, raw=True)]
+        self.assertGreater(len(original), 200)
+        for topic in topics:
+            a = [m for t, m in original if t == topic]
+            b = [m for t, m in replayed if t == topic]
+            self.assertGreater(len(a), 0, topic)
+            self.assertEqual(len(b), len(a), topic)
+            self.assertTrue(a == b, topic + ': a replayed message differs')
 
 
 class BadConeIndex(unittest.TestCase):
