@@ -267,6 +267,7 @@ TEST(SingleWheelConfig, RefusesBadInputNamingTheKey) {
   ExpectRefused({"wheel.slip=1.5"}, "wheel.slip");
   ExpectRefused({"wheel.slip=-1.01"}, "wheel.slip");
   ExpectRefused({"wheel.slip=1"}, "wheel.slip");  // an infinite wheel speed
+  ExpectRefused({"wheel.drive=torque", "wheel.torque=2e5"}, "wheel.torque");
   ExpectRefused({"wheel.drive=skid"}, "wheel.drive");
   ExpectRefused({"fidelity=tiny", "levels.tiny.width=0.4"}, "levels.tiny.width");  // the tire is 0.254 m + 2 x 0.1 m
   ExpectRefused({"carriage.window=[0.8, 3.0]"}, "carriage.window");

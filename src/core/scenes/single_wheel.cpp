@@ -21,6 +21,14 @@ const char* SingleWheelParams::DriveName(Drive d) {
   return "?";
 }
 
+std::pair<std::string, std::string> SingleWheelParams::DriveProblem(Drive drive, double slip, double torque) {
+  if (!(slip >= -1.0 && slip <= 1.0)) return {"slip", "must lie in [-1, 1], not " + detail::Concat(slip)};
+  if (drive == Drive::kSlip && slip == 1.0)
+    return {"slip", "of 1 needs an infinite wheel speed at a moving carriage: use a slip below 1"};
+  if (!(torque >= -1e5 && torque <= 1e5)) return {"torque", "must lie in [-1e5, 1e5] N m, not " + detail::Concat(torque)};
+  return {};
+}
+
 SingleWheelParams SingleWheelParams::Read(const YamlReader& y) {
   SingleWheelParams p;
   p.file = y.file();
@@ -41,10 +49,9 @@ SingleWheelParams SingleWheelParams::Read(const YamlReader& y) {
     w.Fail("drive", "must be slip, towed or torque, not '" + drive + "'");
   }
   p.slip = w.Double("slip", 0.2);
-  if (!(p.slip >= -1.0 && p.slip <= 1.0)) w.Fail("slip", "must lie in [-1, 1], not " + detail::Concat(p.slip));
-  if (p.drive == Drive::kSlip && p.slip == 1.0)
-    w.Fail("slip", "of 1 needs an infinite wheel speed at a moving carriage: use a slip below 1");
-  p.torque = w.DoubleIn("torque", -1e5, 1e5, 0.0);
+  p.torque = w.Double("torque", 0.0);
+  const auto [key, problem] = DriveProblem(p.drive, p.slip, p.torque);
+  if (!key.empty()) w.Fail(key, problem);
   p.load_mass = w.DoubleIn("load_mass", 1.0, 1e5);
   p.speed = w.DoubleIn("speed", 1e-3, 20.0);
   p.wheel_inertia = w.DoubleIn("inertia", 1e-3, 1e4, 6.0);
@@ -124,11 +131,8 @@ SingleWheelRig::SingleWheelRig(const SingleWheelRig& rested, SingleWheelParams::
   if (phase_ != Phase::kDrive || t_phase_ != 0.0)
     throw ConfigError(p_.file + ": a rig takes another drive only after its rest and before its first drive step (it is in '" +
                       phase() + "')");
-  // the bounds SingleWheelParams::Read sets
-  if (!(slip >= -1.0 && slip <= 1.0) || (drive == SingleWheelParams::Drive::kSlip && slip == 1.0))
-    throw ConfigError(detail::Concat(p_.file, ": wheel.slip: ", slip, " is outside [-1, 1) (a slip drive) or [-1, 1]"));
-  if (!(torque >= -1e5 && torque <= 1e5))
-    throw ConfigError(detail::Concat(p_.file, ": wheel.torque: ", torque, " is outside [-1e5, 1e5] N m"));
+  const auto [key, problem] = SingleWheelParams::DriveProblem(drive, slip, torque);  // (Read's bounds)
+  if (!key.empty()) throw ConfigError(p_.file + ": wheel." + key + ": " + problem);
   p_.drive = drive;
   p_.slip = slip;
   p_.torque = torque;

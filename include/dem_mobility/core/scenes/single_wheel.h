@@ -15,6 +15,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dem_mobility/core/scenes/soil_rig.h"
@@ -51,6 +52,10 @@ struct SingleWheelParams {
   static SingleWheelParams Read(const YamlReader& y);
   double Weight() const { return load_mass * gravity; }
   static const char* DriveName(Drive d);
+  /// What is wrong with a drive's slip and torque, as (key of the `wheel` map, message), or an
+  /// empty key: a slip outside [-1, 1] (1 with a slip drive: an infinite wheel speed), a torque
+  /// outside +-1e5 N m. Read and a rested rig's other drive both check through it.
+  static std::pair<std::string, std::string> DriveProblem(Drive drive, double slip, double torque);
 };
 
 /// One sample: means over `sample_interval`.
