@@ -8,8 +8,8 @@
 #   ./scripts/bench.sh wheel_soil       the single-wheel rig's DEM step, beside the same soil without the tire
 #   ./scripts/bench.sh soil_scene       the vehicle on the moving soil patch per level: wall s per simulated s,
 #                                       and the coupled step's rate against the bare soil patch
-#                                       (levels: DM_SOIL_LEVELS, default tiny,coarse,paper; about 1.2 h in all,
-#                                       paper 45 min: see the soil_scene section below)
+#                                       (levels: DM_SOIL_LEVELS, default tiny,coarse,paper; tiny and coarse
+#                                       about 20 min, paper hours: see the soil_scene section below)
 #   ./scripts/bench.sh doe_map          the time to map a 22 km x 22 km region (1101 x 1101 cells) from a finished table
 source "$(dirname "$0")/lib.sh"
 want="${1:-all}"
