@@ -33,6 +33,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import dm_sweep  # noqa: E402
 from dm_sweep.args import keep_options  # noqa: E402
+from dm_sweep.figures import save_figure  # noqa: E402
 
 ROOT = os.path.dirname(HERE)
 # particle diameter of each level (config/terrains/soil_patch.yaml), finest first
@@ -302,7 +303,8 @@ def plot(rows, path, unfinished=()):
     ax.grid(True, which='both', alpha=0.3)
     ax.legend(loc='lower right')
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, 'soil_fidelity_study')
+    plt.close(fig)
 
 
 def main():

@@ -16,15 +16,15 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import soil_fidelity_study as study  # noqa: E402
 
 
-def rows_of(runs):
+def rows_of(runs, name):
     """The study's rows: per case, each run's error against the case's finest finished run."""
     rows = []
     for r in runs:
         for key in ('grade', 'cone_index', 'level', 'speed_made_good', 'wall_time'):
             if key not in r:
-                raise SystemExit('a run lacks %s: %s' % (key, r))
+                raise SystemExit('%s: a run lacks %s: %s' % (name, key, r))
         if r['level'] not in study.LEVEL_ORDER:
-            raise SystemExit('unknown level %r (have %s)' % (r['level'], ', '.join(study.LEVEL_ORDER)))
+            raise SystemExit('%s: unknown level %r (have %s)' % (name, r['level'], ', '.join(study.LEVEL_ORDER)))
     for r in runs:
         case = [x for x in runs if (x['grade'], x['cone_index']) == (r['grade'], r['cone_index'])]
         finest = min(case, key=lambda x: study.LEVEL_ORDER.index(x['level']))
@@ -49,7 +49,7 @@ def main():
         for key in ('grade', 'cone_index', 'level', 'speed_reached', 'simulated_time', 'wall_time'):
             if key not in u:
                 raise SystemExit('%s: an unfinished run lacks %s' % (a.runs, key))
-    study.plot(rows_of(data['runs']), a.png, unfinished=data.get('unfinished') or [])
+    study.plot(rows_of(data['runs'], a.runs), a.png, unfinished=data.get('unfinished') or [])
     print(a.png)
 
 
