@@ -80,7 +80,13 @@ int main(int argc, char** argv) {
       p.end_when_steady = false;
       const VehicleSpec spec = VehicleSpec::Load(p.vehicle_file);
       auto t0 = std::chrono::steady_clock::now();
-      std::unique_ptr<TerrainModel> terrain = LoadTerrainModel(p.terrain_file, TerrainVehicleOf(spec), p.terrain_overrides);
+      PreparationHooks hooks;  // (on stderr: the benchmark's lines stay as they are)
+      hooks.progress = [&level](const PreparationProgress& at) {
+        std::fprintf(stderr, "soil_scene_bench: %s: preparing: %s\n", level.c_str(), at.Line().c_str());
+      };
+      hooks.progress_every = 60.0;
+      std::unique_ptr<TerrainModel> terrain =
+          LoadTerrainModel(p.terrain_file, TerrainVehicleOf(spec), p.terrain_overrides, hooks);
       const double prepare = Seconds(t0);
       auto* soil = dynamic_cast<DemSoilTerrain*>(terrain.get());
       if (!soil) throw ConfigError(p.terrain_file + ": the soil_scene benchmark needs a dem_soil terrain");

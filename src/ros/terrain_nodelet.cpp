@@ -77,9 +77,15 @@ class TerrainNodelet : public nodelet::Nodelet {
       const auto t0 = std::chrono::steady_clock::now();
       // a shutdown (SIGINT, SIGTERM, the manager unloading this nodelet) stops the preparation
       // within a step: the exchange is then closed with the reason, so the vehicle's wait ends
+      PreparationHooks hooks;
+      hooks.stop = [this] { return stop_prepare_.load() || !ros::ok(); };
+      hooks.progress = [this](const PreparationProgress& at) {
+        NODELET_INFO("terrain: preparing the soil: %s", at.Line().c_str());
+      };
+      hooks.progress_every = 30.0;
       std::unique_ptr<TerrainModel> model =
           LoadTerrainModel(scene.terrain_file, TerrainVehicleOf(VehicleSpec::Load(scene.vehicle_file)),
-                           scene.terrain_overrides, [this] { return stop_prepare_.load() || !ros::ok(); });
+                           scene.terrain_overrides, hooks);
       model->SetGravity(scene.Gravity());  // the soil on the grade, as in-process
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       server = std::make_unique<ExchangeServer<WheelStates, WheelWrenches>>(

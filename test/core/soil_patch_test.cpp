@@ -769,13 +769,43 @@ TEST(Checkpoint, APreparedSoilIsKeptAndReadBackBitForBit) {
   const std::vector<std::string> o = {"fidelity=tiny", "threads=1", "cone_index=80", "track_strip_width=0.5",
                                       "levels.tiny.length=" + std::to_string(kShortBox),
                                       "patch.check_window=[0.3, 0.7]"};
-  const auto load = [&]() {
-    std::unique_ptr<TerrainModel> m = LoadTerrainModel(kTerrain, vehicle, o);
+  const auto load = [&](const PreparationHooks& hooks = {}) {
+    std::unique_ptr<TerrainModel> m = LoadTerrainModel(kTerrain, vehicle, o, hooks);
     std::unique_ptr<DemSoilTerrain> t(dynamic_cast<DemSoilTerrain*>(m.release()));
     if (!t) throw std::runtime_error("not a dem_soil terrain");
     return t;
   };
-  std::unique_ptr<DemSoilTerrain> a = load(), b = load();
+  // the preparation's progress: told at every step (progress_every 0), its phases in their order,
+  // its times rising, its particle count the bed's; a soil read from the cache prepares nothing
+  std::vector<PreparationProgress> told;
+  PreparationHooks every_step;
+  every_step.progress = [&told](const PreparationProgress& at) { told.push_back(at); };
+  every_step.progress_every = 0.0;
+  std::unique_ptr<DemSoilTerrain> a = load(every_step);
+  const auto phases_told = [&told] {
+    std::vector<std::string> p;
+    for (const PreparationProgress& at : told)
+      if (p.empty() || p.back() != at.phase) p.push_back(at.phase);
+    return p;
+  };
+  const std::vector<std::string> in_order = {"pour", "consolidate", "retreat", "release", "done"};
+  EXPECT_EQ(phases_told(), in_order);
+  ASSERT_GT(told.size(), 100u);
+  for (size_t i = 1; i < told.size(); ++i) {
+    EXPECT_GE(told[i].simulated, told[i - 1].simulated) << i;
+    EXPECT_GE(told[i].wall, told[i - 1].wall) << i;
+    EXPECT_EQ(told[i].particles, a->bin().dem().num_alive()) << i;
+  }
+  EXPECT_EQ(told.back().simulated, a->bin().dem().time());
+  for (const PreparationProgress& at : told) {
+    if (at.phase == "consolidate") {
+      EXPECT_NE(at.detail.find("of 33.3 kPa"), std::string::npos) << at.detail;
+    }
+  }
+  EXPECT_EQ(told.back().Line().rfind("done: ", 0), 0u) << told.back().Line();
+  told.clear();
+  std::unique_ptr<DemSoilTerrain> b = load(every_step);
+  EXPECT_TRUE(told.empty());
   std::vector<std::string> files;
   for (const auto& e : std::filesystem::directory_iterator(dir)) files.push_back(e.path().string());
   ASSERT_EQ(files.size(), 1u);
@@ -800,8 +830,13 @@ TEST(Checkpoint, APreparedSoilIsKeptAndReadBackBitForBit) {
   EXPECT_GT(fz, 0.0);  // the tires were in the soil
   // a damaged cache file: prepared again (and the file written whole again)
   std::filesystem::resize_file(files[0], std::filesystem::file_size(files[0]) / 2);
-  std::unique_ptr<DemSoilTerrain> c = load();
+  // prepared again, told once a phase when the interval is longer than the preparation
+  PreparationHooks each_phase = every_step;
+  each_phase.progress_every = 1e9;
+  std::unique_ptr<DemSoilTerrain> c = load(each_phase);
   EXPECT_EQ(c->prepared_from(), "");
+  EXPECT_EQ(told.size(), in_order.size());
+  EXPECT_EQ(phases_told(), in_order);
   EXPECT_EQ(load()->prepared_from(), files[0]);
   if (was)
     ::setenv("DM_SOIL_CACHE", before.c_str(), 1);

@@ -50,9 +50,9 @@ void CheckpointIdentity::CheckRestart(const std::string& checkpoint, const std::
   }
 }
 
-MobilityRun::MobilityRun(const MobilityRunParams& p, const std::function<bool()>& stop)
+MobilityRun::MobilityRun(const MobilityRunParams& p, const PreparationHooks& hooks)
     : spec_(VehicleSpec::Load(p.vehicle_file)),
-      terrain_(LoadTerrainModel(p.terrain_file, TerrainVehicleOf(spec_), p.terrain_overrides, stop)),
+      terrain_(LoadTerrainModel(p.terrain_file, TerrainVehicleOf(spec_), p.terrain_overrides, hooks)),
       port_(*terrain_),
       driver_(p.driver, spec_),
       sim_(p, spec_) {

@@ -79,7 +79,14 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
                 restarted.driver_time, restarted.step, resume.r.wall_time);
   } else {
     try {
-      made = std::make_unique<MobilityRun>(p, [s = o.stop] { return s && s->load(std::memory_order_relaxed); });
+      PreparationHooks hooks;
+      hooks.stop = [s = o.stop] { return s && s->load(std::memory_order_relaxed); };
+      if (!o.quiet)  // (a soil at a fine level prepares for minutes to hours)
+        hooks.progress = [](const PreparationProgress& at) {
+          std::printf("  preparing the terrain: %s\n", at.Line().c_str());
+          std::fflush(stdout);
+        };
+      made = std::make_unique<MobilityRun>(p, hooks);
     } catch (const Interrupted& e) {
       // stopped while the terrain prepared, before the run began: the result and the history (its
       // header) say so, the result with how far the preparation had come

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "dem_mobility/core/common/error.h"
@@ -115,6 +116,37 @@ const char* SoilPreparation::PhaseName(Phase p) {
     case Phase::kDone: return "done";
   }
   return "?";
+}
+
+std::string SoilPreparation::Detail() const {
+  const double dt = s_->dt();
+  char b[200];
+  switch (phase_) {
+    case Phase::kPour:
+      std::snprintf(b, sizeof b, "settling before the lid, %.3f of %.3f s", phase_steps_ * dt, p_.settle_time);
+      break;
+    case Phase::kConsolidate: {
+      const DemWall& w = s_->wall(lid_);
+      const int n = std::snprintf(b, sizeof b, "lid at z = %.3f m, %.1f of %.1f kPa", w.position.z(),
+                                  w.force.z() / area_ / 1e3, p_.lid_pressure / 1e3);
+      if (hold_ && hold_->holding())
+        std::snprintf(b + n, sizeof b - n, ", held %.3f of %.3f s", hold_->held_time(), p_.hold_time);
+      else
+        std::snprintf(b + n, sizeof b - n, ", pressing for %.3f s", phase_steps_ * dt);
+      break;
+    }
+    case Phase::kRetreat:
+      std::snprintf(b, sizeof b, "lid rising, at z = %.3f m, %d particles touching it", s_->wall(lid_).position.z(),
+                    s_->wall(lid_).contacts);
+      break;
+    case Phase::kRelease:
+      std::snprintf(b, sizeof b, "settling without the lid, %.3f of %.3f s", phase_steps_ * dt, p_.release_time);
+      break;
+    case Phase::kDone:
+      std::snprintf(b, sizeof b, "layer %.3f m high (%.3f m poured)", height_consolidated_, height_poured_);
+      break;
+  }
+  return b;
 }
 
 void SoilPreparation::NextPhase(Phase next) {

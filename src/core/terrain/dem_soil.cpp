@@ -401,19 +401,33 @@ WheelWrench DemSoilBin::Wrench(int k) const {
 // ---------------------------------------------------------------------------------------------
 
 DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels,
-                               const std::function<bool()>& stop)
+                               const PreparationHooks& hooks)
     : bin_(std::make_unique<DemSoilBin>(p, tire, wheels)) {
   const auto t0 = std::chrono::steady_clock::now();
+  auto wall = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   description_ = SoilDescription(p);
+  // progress when a phase begins, every progress_every wall seconds within one, and at the end
+  std::string told_phase;
+  double told_at = 0.0;
+  auto tell = [&] {
+    if (!hooks.progress) return;
+    const double w = wall();
+    const std::string phase = bin_->phase();
+    if (phase == told_phase && w - told_at < hooks.progress_every) return;
+    told_phase = phase;
+    told_at = w;
+    hooks.progress(PreparationProgress{phase, bin_->dem().time(), w, bin_->dem().num_alive(),
+                                       bin_->preparation().Detail()});
+  };
   while (!bin_->prepared()) {
-    if (stop && stop())
+    if (hooks.stop && hooks.stop())
       throw Interrupted(detail::Concat("interrupted while the soil (", p.file, ", level ", p.level.name, ", ",
                                        bin_->dem().num_alive(), " particles) was being prepared: phase ", bin_->phase(),
-                                       ", ", bin_->dem().time(), " s of the preparation simulated in ",
-                                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                                       " s"));
+                                       ", ", bin_->dem().time(), " s of the preparation simulated in ", wall(), " s"));
+    tell();
     bin_->PrepareStep();
   }
+  tell();
   // The vehicle starts with its tires touching the plane z = 0. That plane goes through the top of
   // the highest particle of the bed's interior (a diameter and more from the walls), so that no
   // tire starts inside a particle; the bed's surface (the mean top of its highest particles, from
@@ -663,11 +677,11 @@ std::string PreparedSoilPath(const std::string& dir, const YamlReader& y, const 
 }  // namespace
 
 std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
-                                                 const std::function<bool()>& stop) {
+                                                 const PreparationHooks& hooks) {
   const size_t mark = InputFileCount();
   const DemSoilParams p = ReadDemSoilFor(y, vehicle);
   const char* dir = std::getenv("DM_SOIL_CACHE");
-  if (!dir || !*dir) return std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels, stop);
+  if (!dir || !*dir) return std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels, hooks);
   const std::string path = PreparedSoilPath(dir, y, InputFilesSince(mark), vehicle);
   std::error_code ec;
   if (std::filesystem::exists(path, ec)) {
@@ -684,7 +698,7 @@ std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const Terr
       std::fprintf(stderr, "dem_soil: the prepared soil does not read (%s): preparing it again\n", e.what());
     }
   }
-  auto t = std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels, stop);
+  auto t = std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels, hooks);
   try {
     std::filesystem::create_directories(dir, ec);
     std::ostringstream os(std::ios::binary);

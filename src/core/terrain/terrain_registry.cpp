@@ -1,6 +1,7 @@
 // The registry of terrain kinds: one row per `model:` (the next kinds are added here).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 
 #include "dem_mobility/core/common/registry.h"
@@ -15,15 +16,21 @@ namespace dem_mobility::core {
 const std::vector<TerrainKind>& TerrainKinds() {
   static const std::vector<TerrainKind> kinds = {
       {"rigid_road", "a rigid polygonal road (tire vertices against its triangles, asperity friction)",
-       [](const YamlReader& y, const TerrainVehicle& v, const std::function<bool()>&) { return MakeRoadTerrain(y, v); },
+       [](const YamlReader& y, const TerrainVehicle& v, const PreparationHooks&) { return MakeRoadTerrain(y, v); },
        &DescribeRoadTerrain, &CheckRoadTerrain, /*restore: built by make, then its LoadState*/ nullptr},
       {"dem_soil", "a DEM soil bin (cohesive particles, prepared under a lid) the tires sink into",
-       [](const YamlReader& y, const TerrainVehicle& v, const std::function<bool()>& stop) {
-         return MakeDemSoilTerrain(y, v, stop);
+       [](const YamlReader& y, const TerrainVehicle& v, const PreparationHooks& hooks) {
+         return MakeDemSoilTerrain(y, v, hooks);
        },
        &DescribeDemSoilTerrain, &CheckDemSoilTerrain, &RestoreDemSoilTerrain},
   };
   return kinds;
+}
+
+std::string PreparationProgress::Line() const {
+  char b[160];
+  std::snprintf(b, sizeof b, "%s: %.3f s simulated in %.0f s, %d particles", phase.c_str(), simulated, wall, particles);
+  return detail.empty() ? std::string(b) : std::string(b) + "; " + detail;
 }
 
 TerrainVehicle TerrainVehicleOf(const VehicleSpec& spec) {
@@ -43,9 +50,9 @@ const TerrainKind& FindTerrainKind(const YamlReader& y) {
 }  // namespace
 
 std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
-                                               const std::vector<std::string>& overrides, const std::function<bool()>& stop) {
+                                               const std::vector<std::string>& overrides, const PreparationHooks& hooks) {
   const YamlReader y = YamlReader::LoadWithOverrides(terrain_file, overrides);
-  return FindTerrainKind(y).make(y, vehicle, stop);
+  return FindTerrainKind(y).make(y, vehicle, hooks);
 }
 
 void CheckTerrainModel(const YamlReader& y, const TerrainVehicle& vehicle) { FindTerrainKind(y).check(y, vehicle); }

@@ -47,9 +47,9 @@ CheckpointIdentity ReadCheckpointIdentity(const std::string& path);
 class MobilityRun {
  public:
   /// Builds the terrain, the driver and the vehicle, and makes the opening exchange (ConfigError
-  /// for bad input or a time step above the limit). `stop` (may be empty) is called while the
-  /// terrain prepares: once it returns true, Interrupted says where the preparation was.
-  explicit MobilityRun(const MobilityRunParams& p, const std::function<bool()>& stop = {});
+  /// for bad input or a time step above the limit). `hooks` are called while the terrain prepares
+  /// (PreparationHooks): once `stop` returns true, Interrupted says where the preparation was.
+  explicit MobilityRun(const MobilityRunParams& p, const PreparationHooks& hooks = {});
   /// The same on a terrain built already (e.g. a copy of a prepared soil: one preparation, many runs).
   MobilityRun(const MobilityRunParams& p, std::unique_ptr<TerrainModel> terrain);
   /// The run of a checkpoint, after its identity (ReadCheckpoint): the terrain restored without

@@ -109,6 +109,9 @@ class SoilPreparation {
   bool done() const { return phase_ == Phase::kDone; }
   Phase phase() const { return phase_; }
   static const char* PhaseName(Phase p);
+  /// What the current phase waits for, in one line: the pour's and release's settling time, the
+  /// lid's height and pressure against its target while it consolidates, its height as it retreats.
+  std::string Detail() const;
   double height_poured() const { return height_poured_; }              ///< layer height before the lid [m]
   double height_consolidated() const { return height_consolidated_; }  ///< after the release [m]
   double lid_pressure_reached() const { return hold_ ? hold_->mean_pressure() : 0.0; }  ///< [Pa]

@@ -197,9 +197,10 @@ class SoilPatch;
 /// exactly minus the one the particles received.
 class DemSoilTerrain final : public TerrainModel {
  public:
-  /// Prepares the soil (pour, lid, settling); `stop` (may be empty) is called every step of it:
-  /// once it returns true, Interrupted names the phase and the simulated time reached.
-  DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels, const std::function<bool()>& stop = {});
+  /// Prepares the soil (pour, lid, settling); `hooks.stop` (may be empty) is called every step of
+  /// it: once it returns true, Interrupted names the phase and the simulated time reached;
+  /// `hooks.progress` hears where it is (PreparationHooks).
+  DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire, int wheels, const PreparationHooks& hooks = {});
   /// The terrain of a checkpoint (common/state_archive.h): the bin built for `p` as above but not
   /// prepared, then its soil, patch and exchange state read from `in` (ConfigError naming the
   /// file when the checkpoint is not of this soil).
@@ -260,7 +261,7 @@ class DemSoilTerrain final : public TerrainModel {
 /// same state: the preparation is deterministic), and a soil prepared here is written there; the
 /// result says `soil_prepared_from`. A cached file that does not read is prepared again (a warning).
 std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
-                                                 const std::function<bool()>& stop = {});
+                                                 const PreparationHooks& hooks = {});
 TerrainDescription DescribeDemSoilTerrain(const YamlReader& y);
 /// The dem_soil terrain of a checkpoint (DemSoilTerrain's restoring constructor).
 std::unique_ptr<TerrainModel> RestoreDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle, StateReader& in);

@@ -82,13 +82,35 @@ struct VehicleSpec;
 /// What a terrain needs of the vehicle `spec` describes (its tire, four wheels, its track).
 TerrainVehicle TerrainVehicleOf(const VehicleSpec& spec);
 
+/// Where a terrain's preparation is (a DEM soil: its pour, the lid's consolidation, the lid's
+/// retreat, the release), for a console or a log while it takes minutes or hours.
+struct PreparationProgress {
+  std::string phase;       ///< pour, consolidate, retreat, release, done
+  double simulated = 0.0;  ///< [s] of the preparation simulated so far
+  double wall = 0.0;       ///< [s] since the preparation began
+  int particles = 0;
+  std::string detail;      ///< what the phase is waiting for (e.g. the lid's height and pressure)
+  /// One line: "consolidate: 0.631 s simulated in 2820 s, 628431 particles; lid at ...".
+  std::string Line() const;
+};
+
+/// What a long preparation calls. `stop` (may be empty): every step; once it returns true the
+/// preparation stops within a step and throws Interrupted saying where it was. `progress` (may be
+/// empty): when a phase begins, about every `progress_every` wall seconds within one, and when
+/// the preparation is done.
+struct PreparationHooks {
+  std::function<bool()> stop;
+  std::function<void(const PreparationProgress&)> progress;
+  double progress_every = 10.0;  ///< [s] of wall time
+};
+
 /// One kind of terrain: the `model:` key of its files, a factory and a describer.
 struct TerrainKind {
   std::string model;
   std::string what;  ///< one line for messages and listings
-  /// `stop` (may be empty): called during a long preparation; true throws Interrupted.
+  /// `hooks`: called during a long preparation (PreparationHooks).
   std::function<std::unique_ptr<TerrainModel>(const YamlReader& file, const TerrainVehicle& vehicle,
-                                              const std::function<bool()>& stop)>
+                                              const PreparationHooks& hooks)>
       make;
   std::function<TerrainDescription(const YamlReader& file)> describe;
   /// Reads and checks every key of the file for `vehicle` as `make` does, building nothing
@@ -105,12 +127,12 @@ const std::vector<TerrainKind>& TerrainKinds();
 
 /// Builds the terrain described by `terrain_file` (with `key=value` overrides, a scene's
 /// terrain_overrides) for the wheels of `vehicle`. Throws ConfigError naming file and key of bad
-/// input (an unknown `model:` lists the known ones). `stop` (may be empty) is called while the
-/// terrain prepares (a DEM soil: every step of its pour, lid and settling): once it returns true,
-/// the preparation stops within a step and Interrupted says where it was.
+/// input (an unknown `model:` lists the known ones). `hooks` are called while the terrain prepares
+/// (a DEM soil: every step of its pour, lid and settling; PreparationHooks): once `stop` returns
+/// true, the preparation stops within a step and Interrupted says where it was.
 std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
                                                const std::vector<std::string>& overrides = {},
-                                               const std::function<bool()>& stop = {});
+                                               const PreparationHooks& hooks = {});
 /// Reads and checks `terrain_file` (with overrides) for `vehicle` as LoadTerrainModel does, building
 /// nothing: the check of `dm_run_scene --check`.
 void CheckTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
