@@ -127,8 +127,9 @@ std::string SoilPreparation::Detail() const {
       break;
     case Phase::kConsolidate: {
       const DemWall& w = s_->wall(lid_);
-      const int n = std::snprintf(b, sizeof b, "lid at z = %.3f m, %.1f of %.1f kPa", w.position.z(),
-                                  w.force.z() / area_ / 1e3, p_.lid_pressure / 1e3);
+      const int n = std::clamp(std::snprintf(b, sizeof b, "lid at z = %.3f m, %.1f of %.1f kPa", w.position.z(),
+                                             w.force.z() / area_ / 1e3, p_.lid_pressure / 1e3),
+                               0, static_cast<int>(sizeof b) - 1);
       if (hold_ && hold_->holding())
         std::snprintf(b + n, sizeof b - n, ", held %.3f of %.3f s", hold_->held_time(), p_.hold_time);
       else
