@@ -407,17 +407,20 @@ DemSoilTerrain::DemSoilTerrain(const DemSoilParams& p, const TireGeometry& tire,
   auto wall = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   description_ = SoilDescription(p);
   // progress when a phase begins, every progress_every wall seconds within one, and at the end
-  std::string told_phase;
+  // (the phase compared as its enum and the clock read only with a listener: nothing per step else)
+  bool told = false;
+  SoilPreparation::Phase told_phase{};
   double told_at = 0.0;
   auto tell = [&] {
     if (!hooks.progress) return;
+    const SoilPreparation::Phase phase = bin_->preparation().phase();
     const double w = wall();
-    const std::string phase = bin_->phase();
-    if (phase == told_phase && w - told_at < hooks.progress_every) return;
+    if (told && phase == told_phase && w - told_at < hooks.progress_every) return;
+    told = true;
     told_phase = phase;
     told_at = w;
-    hooks.progress(PreparationProgress{phase, bin_->dem().time(), w, bin_->dem().num_alive(),
-                                       bin_->preparation().Detail()});
+    hooks.progress(PreparationProgress{SoilPreparation::PhaseName(phase), bin_->dem().time(), w,
+                                       bin_->dem().num_alive(), bin_->preparation().Detail()});
   };
   while (!bin_->prepared()) {
     if (hooks.stop && hooks.stop())
