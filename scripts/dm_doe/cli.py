@@ -467,6 +467,12 @@ def cmd_run(a):
     if a.dry_run:
         print('dry run: nothing run')
         return 0
+    if doc['runner'] == 'roslaunch':
+        problem = runner.roslaunch_problem()
+        if problem:
+            raise UsageError('--runner roslaunch: %s. Source the catkin workspace first (after a build: '
+                             'source ~/.cache/dem_mobility/ws-*/devel/setup.bash, as the README says), '
+                             'or run the cases in one process with --runner core' % problem)
     os.makedirs(runner.runs_dir(a.out), exist_ok=True)
     if not os.path.exists(path):
         runner.write_yaml(path, doc)

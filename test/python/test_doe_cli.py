@@ -25,8 +25,8 @@ DOE = os.path.join(ROOT, 'scripts', 'doe')
 ST_HELENS = os.path.join(os.path.dirname(ROOT), 'shared', 'data', 'mount_st_helens_30m_utm10n_nad27.tif')
 
 
-def doe(*args):
-    p = subprocess.run([sys.executable, DOE] + list(args), capture_output=True, text=True)
+def doe(*args, env=None):
+    p = subprocess.run([sys.executable, DOE] + list(args), capture_output=True, text=True, env=env)
     return p.returncode, p.stdout, p.stderr
 
 
@@ -138,6 +138,19 @@ class Doe(unittest.TestCase):
         self.assertEqual(rc, 2)
         self.assertIn('cone index 200 psi: outside the tiny level', err)
         self.assertIn('cone_index_mu0.1_d0.1.yaml', err)
+
+    def test_a_run_where_ros_cannot_find_the_package_is_refused_before_anything_is_written(self):
+        # a shell without the workspace's setup.bash: every roslaunch would fail at once with
+        # roslaunch's own error; the DOE says what is missing and writes nothing
+        empty = tempfile.mkdtemp(dir=self.tmp)
+        out = os.path.join(self.tmp, 'no_ros')
+        env = dict(os.environ, ROS_PACKAGE_PATH=empty, ROS_HOME=empty)
+        rc, _, err = doe('run', '--out', out, '--level', 'tiny', '--grades', '0', '--cone-indices', '300', env=env)
+        self.assertEqual(rc, 2, err)
+        self.assertIn('--runner roslaunch: ROS cannot find the package dem_mobility', err)
+        self.assertIn('devel/setup.bash', err)
+        self.assertIn('--runner core', err)
+        self.assertFalse(os.path.exists(out))
 
     def test_a_bad_table_is_refused_naming_it_before_any_map_is_written(self):
         good = {'grades': [0.0, 12.0], 'cone_indices': [30.0, 300.0], 'speed': [[10.0, 20.0], [5.0, 15.0]]}
