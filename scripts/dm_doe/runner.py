@@ -427,6 +427,9 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
         port = free_port(port_from_env())
     argv = case_command(doc, case, out, port, dm_run_scene)
     log = os.path.join(runs_dir(out), case['name'] + '.log')
+    # the checkout the run starts from (the provenance's commit: a commit made while a case runs
+    # is not the code it ran)
+    commit = git_commit(ROOT)
     t0 = time.time()
     child = []
 
@@ -443,7 +446,7 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
             wait_pid(c.pid, 20)
         if own_exit in (None, 0) and verdict(case, read_result(result_path(out, case))) is None:
             write_yaml(provenance_path(out, case), {
-                'commit': git_commit(ROOT), 'host': socket.gethostname(), 'slurm_job': os.environ.get('SLURM_JOB_ID'),
+                'commit': commit, 'host': socket.gethostname(), 'slurm_job': os.environ.get('SLURM_JOB_ID'),
                 'argv': argv, 'wall_time': round(time.time() - t0, 1), 'exit_status': 0,
                 'signal_after_result': signum})
             with contextlib.suppress(OSError):
@@ -475,7 +478,7 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         with contextlib.suppress(OSError):
             os.remove(marker_path(out, case))
-    write_yaml(provenance_path(out, case), {'commit': git_commit(ROOT), 'host': socket.gethostname(),
+    write_yaml(provenance_path(out, case), {'commit': commit, 'host': socket.gethostname(),
                                             'slurm_job': os.environ.get('SLURM_JOB_ID'), 'argv': argv,
                                             'wall_time': round(time.time() - t0, 1), 'exit_status': rc})
     r = read_result(result_path(out, case))
