@@ -24,7 +24,6 @@ import argparse
 import math
 import os
 import shutil
-import subprocess
 import sys
 import time
 
@@ -33,7 +32,7 @@ import yaml
 # dm_sweep lives beside this script (also when run through catkin's relay in devel/lib)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import dm_sweep  # noqa: E402
-from dm_sweep.args import floats, git_commit, ints, keep_options, number, sha256  # noqa: E402
+from dm_sweep.args import floats, git_commit, ints, keep_options, number, ros_package, sha256  # noqa: E402
 
 PAPER_TABLE = [(30, 0.06), (40, 0.15), (50, 0.5), (60, 0.84), (70, 1.18), (80, 1.52), (100, 2.24),
                (120, 3.03), (150, 4.46), (200, 7.85), (242, 12.1)]
@@ -334,12 +333,9 @@ def main():
         soil_sha, scene_sha = sha256(soil_file), sha256(a.scene)
     except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as e:
         sys.exit('calibrate_cone_index: %s' % e)
-    if shutil.which('roslaunch') is None:
-        sys.exit('calibrate_cone_index: roslaunch not found: source the catkin workspace (devel/setup.bash) first')
-    if subprocess.run(['rospack', 'find', 'dem_mobility'], stdout=subprocess.DEVNULL,
-                      stderr=subprocess.DEVNULL).returncode != 0:
-        sys.exit('calibrate_cone_index: ROS does not know the package dem_mobility: '
-                 'source the catkin workspace (devel/setup.bash) that built it first')
+    _, why = ros_package()
+    if why:
+        sys.exit('calibrate_cone_index: %s: source the catkin workspace (devel/setup.bash) that built it first' % why)
     os.makedirs(os.path.join(a.out, 'runs'), exist_ok=True)
     try:
         at = dict(a.seeds_at)

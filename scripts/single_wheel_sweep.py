@@ -28,8 +28,6 @@ the sweep without the ROS build, NOT the launch files users run (no bag is writt
 import argparse
 import math
 import os
-import shutil
-import subprocess
 import sys
 import time
 
@@ -40,7 +38,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import dm_sweep  # noqa: E402
 from dm_sweep import wheel_numerics as wn  # noqa: E402
-from dm_sweep.args import floats, keep_options, number as num, sha256  # noqa: E402
+from dm_sweep.args import floats, keep_options, number as num, ros_package, sha256  # noqa: E402
 from dm_sweep.wheel_plots import plots, soil_label  # noqa: E402,F401
 
 ROOT = os.path.dirname(HERE)
@@ -405,14 +403,10 @@ def main(argv=None):
     if not os.path.isfile(a.scene):
         sys.exit('%s: no scene file %s' % (PROG, a.scene))
     if a.runner == 'roslaunch':
-        if shutil.which('roslaunch') is None:
-            sys.exit('%s: roslaunch not found: source the catkin workspace (devel/setup.bash) first' % PROG)
-        found = subprocess.run(['rospack', 'find', 'dem_mobility'], stdout=subprocess.PIPE,
-                               stderr=subprocess.DEVNULL, universal_newlines=True)
-        if found.returncode != 0:
-            sys.exit('%s: ROS does not know the package dem_mobility: source the catkin workspace '
-                     '(devel/setup.bash) that built it first' % PROG)
-        launch = os.path.join(found.stdout.strip(), 'launch', 'single_wheel.launch')
+        package, why = ros_package()
+        if why:
+            sys.exit('%s: %s: source the catkin workspace (devel/setup.bash) that built it first' % (PROG, why))
+        launch = os.path.join(package, 'launch', 'single_wheel.launch')
         if not os.path.isfile(launch):
             sys.exit('%s: no %s in this checkout' % (PROG, launch))
     elif not os.access(a.dm_run_scene, os.X_OK):

@@ -20,7 +20,7 @@ import time
 import numpy as np
 import yaml
 
-from dm_sweep.args import floats, git_commit
+from dm_sweep.args import floats, git_commit, ros_package
 
 import dm_sweep
 
@@ -468,7 +468,7 @@ def cmd_run(a):
         print('dry run: nothing run')
         return 0
     if doc['runner'] == 'roslaunch':
-        problem = runner.roslaunch_problem()
+        _, problem = ros_package()
         if problem:
             raise UsageError('--runner roslaunch: %s. Source the catkin workspace first (after a build: '
                              'source ~/.cache/dem_mobility/ws-*/devel/setup.bash, as the README says), '

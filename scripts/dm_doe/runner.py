@@ -21,7 +21,6 @@ import datetime
 import fcntl
 import hashlib
 import os
-import shutil
 import signal
 import socket
 import subprocess
@@ -336,23 +335,6 @@ def case_command(doc, case, out, port, dm_run_scene=None):
         argv += ['terrain_overrides.fidelity=' + doc['level'], 'terrain_overrides.cone_index=%g' % c,
                  'terrain_overrides.threads=%d' % doc['dem_threads']]
     return argv + ['--out', result, '--history', result[:-len('.result.yaml')] + '.history.csv']
-
-
-def roslaunch_problem():
-    """Why the roslaunch runner could not start a case here (None if it can): roslaunch on the PATH
-    and the package found by ROS (a shell without the workspace's setup.bash has neither, and every
-    case would fail in a second with roslaunch's own error)."""
-    if not shutil.which('roslaunch'):
-        return 'roslaunch is not on the PATH'
-    try:
-        p = subprocess.run(['rospack', 'find', 'dem_mobility'], capture_output=True, text=True, timeout=60)
-    except (OSError, subprocess.TimeoutExpired) as e:
-        return 'rospack find dem_mobility: %s' % e
-    if p.returncode != 0:
-        return 'ROS cannot find the package dem_mobility (rospack find dem_mobility: %s; ROS_PACKAGE_PATH=%s)' % (
-            (p.stderr.strip().splitlines() or ['exit status %d' % p.returncode])[-1],
-            os.environ.get('ROS_PACKAGE_PATH', ''))
-    return None
 
 
 def free_port(port):

@@ -39,6 +39,24 @@ def git_commit(root):
         return 'unknown (not a git checkout)'
 
 
+def ros_package(package='dem_mobility'):
+    """(its folder, None) where a run through roslaunch can start here: roslaunch on the PATH and
+    the package found by ROS; else (None, why not). A shell without the catkin workspace's
+    devel/setup.bash has neither, and every run would fail at once with roslaunch's own error."""
+    import shutil
+    if shutil.which('roslaunch') is None:
+        return None, 'roslaunch is not on the PATH'
+    try:
+        p = subprocess.run(['rospack', 'find', package], capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired) as e:
+        return None, 'rospack find %s: %s' % (package, e)
+    if p.returncode != 0:
+        return None, 'ROS cannot find the package %s (rospack find %s: %s; ROS_PACKAGE_PATH=%s)' % (
+            package, package, (p.stderr.strip().splitlines() or ['exit status %d' % p.returncode])[-1],
+            os.environ.get('ROS_PACKAGE_PATH', ''))
+    return p.stdout.strip(), None
+
+
 def number(x):
     """A number for a command line with every digit kept: the shortest form that reads back as the
     same float ('%g' would run 1234.567 as 1234.57), a whole number without '.0'."""
