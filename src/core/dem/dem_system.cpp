@@ -201,30 +201,30 @@ void DemSystem::Step() {
   for (int i = 0; i < n; ++i)
     if (ps_.live(i) && OverlapTrips(ps_, i, overlap_limit)) tripped = std::min(tripped, i);
   if (tripped < n) ReportOverlapTrip(ps_, tripped, soil_.diameter, settings_.max_overlap, step_, time_);
-  if (plastic_ledger_ && static_cast<int>(plastic_changed_.size()) < n) {
-    plastic_before_.resize(n);
-    adhesion_before_.resize(n);
-    plastic_de_.resize(n);
-    plastic_changed_.resize(n);
-  }
   const bool ledger = plastic_ledger_;
+  if (ledger && static_cast<int>(plastic_rec_.size()) < n) {
+    plastic_rec_.resize(n);
+    plastic_de_.resize(n);
+  }
   int changed = 0;
 #pragma omp parallel for schedule(static) num_threads(Threads()) reduction(+ : changed)
   for (int i = 0; i < n; ++i) {
-    if (ledger) plastic_changed_[i] = 0;
     if (!ps_.live(i)) continue;
     if (!ps_.held[i]) v[i] += h * inv_m * f[i];
-    const double dp =
-        UpdatePlasticDeformation(soil_, ps_.plastic[i], ps_.max_repulsion[i], ps_.max_tension[i], dt_);
-    if (dp != ps_.plastic[i]) {
-      if (ledger) {
-        plastic_before_[i] = ps_.plastic[i];
-        adhesion_before_[i] = ps_.adhesion_max[i];
-        plastic_changed_[i] = 1;
-        ++changed;
-      }
+    const double p0 = ps_.plastic[i], a0 = ps_.adhesion_max[i];
+    const double dp = UpdatePlasticDeformation(soil_, p0, ps_.max_repulsion[i], ps_.max_tension[i], dt_);
+    if (dp != p0) {
       ps_.plastic[i] = dp;
       ps_.adhesion_max[i] = MaxAdhesionForce(soil_, dp);
+      ++changed;
+    }
+    if (ledger) {
+      PlasticRecord& r = plastic_rec_[i];
+      r.x = x[i];
+      r.p0 = p0;
+      r.a0 = a0;
+      r.p1 = ps_.plastic[i];
+      r.a1 = ps_.adhesion_max[i];
     }
   }
   if (ledger && changed > 0) PlasticExchange();
@@ -233,29 +233,30 @@ void DemSystem::Step() {
 void DemSystem::PlasticExchange() {
   // the energy the changed deformations (and adhesions) moved, at the positions they changed at:
   // every listed pair with a changed end, its normal energy after less before; per slot in
-  // parallel, summed in slot order (the same sum on any number of threads)
+  // parallel, summed in slot order (the same sum on any number of threads). A slot's record holds
+  // what the pass reads of it (the step's plastic update wrote it): one cache line per partner
   const int n = ps_.slots();
   const double D = soil_.diameter;
+  const PlasticRecord* rec = plastic_rec_.data();
+  const int* partners = lists_.partners().data();
 #pragma omp parallel for schedule(static) num_threads(Threads())
   for (int i = 0; i < n; ++i) {
     double de = 0.0;
     if (ps_.live(i)) {
-      const bool ci = plastic_changed_[i] != 0;
-      for (int k = lists_.begin(i); k < lists_.end(i); ++k) {
-        const int j = lists_.partners()[k];
-        const bool cj = plastic_changed_[j] != 0;
-        if (!ci && !cj) continue;
-        const double pi0 = ci ? plastic_before_[i] : ps_.plastic[i], pj0 = cj ? plastic_before_[j] : ps_.plastic[j];
+      const PlasticRecord& ri = rec[i];
+      const bool ci = ri.p1 != ri.p0;
+      const int end = lists_.end(i);
+      for (int k = lists_.begin(i); k < end; ++k) {
+        const PlasticRecord& rj = rec[partners[k]];
+        if (!ci && rj.p1 == rj.p0) continue;
+        const double p1 = ri.p1 + rj.p1, p0 = ri.p0 + rj.p0;
         // out of reach before and after the change (no overlap either way): nothing moved, and
         // no square root taken
-        const double reach = D - std::min(ps_.plastic[i] + ps_.plastic[j], pi0 + pj0);
-        const double r2 = (ps_.x[i] - ps_.x[j]).squaredNorm();
+        const double reach = D - std::min(p1, p0);
+        const double r2 = (ri.x - rj.x).squaredNorm();
         if (!(reach > 0.0) || r2 >= reach * reach) continue;
         const double gap = D - std::sqrt(r2);
-        const double ai0 = ci ? adhesion_before_[i] : ps_.adhesion_max[i];
-        const double aj0 = cj ? adhesion_before_[j] : ps_.adhesion_max[j];
-        de += NormalEnergy(law_, gap - (ps_.plastic[i] + ps_.plastic[j]), std::min(ps_.adhesion_max[i], ps_.adhesion_max[j])) -
-              NormalEnergy(law_, gap - (pi0 + pj0), std::min(ai0, aj0));
+        de += NormalEnergy(law_, gap - p1, std::min(ri.a1, rj.a1)) - NormalEnergy(law_, gap - p0, std::min(ri.a0, rj.a0));
       }
     }
     plastic_de_[i] = de;
@@ -309,7 +310,10 @@ DemContactSummary DemSystem::ContactSummary() const {
   return out;
 }
 
-size_t DemSystem::MemoryBytes() const { return ps_.MemoryBytes() + lists_.MemoryBytes() + walls_.MemoryBytes(); }
+size_t DemSystem::MemoryBytes() const {
+  return ps_.MemoryBytes() + lists_.MemoryBytes() + walls_.MemoryBytes() +
+         plastic_rec_.capacity() * sizeof(PlasticRecord) + plastic_de_.capacity() * sizeof(double);
+}
 
 Vector3d DemSystem::Momentum() const {
   Vector3d p = Vector3d::Zero();
@@ -321,8 +325,7 @@ Vector3d DemSystem::Momentum() const {
 template <class Ar>
 void DemSystem::Io(Ar& ar) {
   ar.Tag("dem");
-  ar(gravity_, dt_, time_, step_, builds_, overflow_builds_, finalized_, rebuild_, ledger_, plastic_ledger_,
-     plastic_before_, adhesion_before_, plastic_de_, plastic_changed_);
+  ar(gravity_, dt_, time_, step_, builds_, overflow_builds_, finalized_, rebuild_, ledger_, plastic_ledger_);
   ps_.Io(ar);
   lists_.Io(ar);
   walls_.Io(ar);
