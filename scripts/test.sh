@@ -21,6 +21,9 @@ build_core
 # The tests of the preparation itself (stopped while it runs) unset it.
 export DM_SOIL_CACHE="$DM_BUILD/soil_cache"
 rm -rf "$DM_SOIL_CACHE"
+# The stages below run side by side on the machine's cores, more threads than cores: OpenMP threads
+# that sleep at a barrier instead of spinning leave the cores to the work (results do not depend on it).
+export OMP_WAIT_POLICY=PASSIVE
 # The core suite is CPU-bound (its tests run side by side on both cores); the stages after it
 # (builds, ROS and python tests) wait on processes, masters and a Slurm scheduler much of the
 # time. So the core suite runs in the background beside them, and its outcome is read at the end.
