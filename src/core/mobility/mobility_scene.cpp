@@ -16,7 +16,7 @@ namespace {
 // a checkpoint file: this line, the format's version, the state (StateWriter), and the Fnv1a of
 // all the bytes before it (a damaged file is refused before anything of it is read)
 constexpr char kMagic[] = "dem_mobility checkpoint\n";
-constexpr uint32_t kFormat = 1;
+constexpr uint32_t kFormat = 2;  // 2: the DEM state without the plastic pass's scratch
 }  // namespace
 
 void CheckpointIdentity::CheckRestart(const std::string& checkpoint, const std::string& scene,
