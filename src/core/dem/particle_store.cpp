@@ -94,9 +94,11 @@ size_t ParticleStore::MemoryBytes() const {
 template <class Ar>
 void ParticleStore::Io(Ar& ar) {
   ar.Tag("particles");
-  ar(x, v, f, x_built, plastic, adhesion_max, max_repulsion, max_tension, overlap, state, held, id_of_slot, hot, ids_,
+  // (not `hot`: the pair kernels' scratch, packed from these arrays before every sweep)
+  ar(x, v, f, x_built, plastic, adhesion_max, max_repulsion, max_tension, overlap, state, held, id_of_slot, ids_,
      free_slots_, removed_);
   if constexpr (Ar::kLoading) {
+    hot.clear();
     const size_t n = x.size();
     for (size_t len : {v.size(), f.size(), x_built.size(), plastic.size(), adhesion_max.size(), max_repulsion.size(),
                        max_tension.size(), overlap.size(), state.size(), held.size(), id_of_slot.size()})

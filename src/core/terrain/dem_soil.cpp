@@ -658,7 +658,7 @@ DemSoilParams ReadDemSoilFor(const YamlReader& y, const TerrainVehicle& vehicle)
 namespace {
 // a prepared soil in DM_SOIL_CACHE: this line, the format, DemSoilTerrain's state (SealState)
 const std::string kSoilMagic = "dem_mobility prepared soil\n";
-constexpr uint32_t kSoilFormat = 2;  // 2: the DEM state without the plastic pass's scratch
+constexpr uint32_t kSoilFormat = 2;  // 2: the DEM state without its scratch (the plastic pass's, the pair kernels' hot records)
 
 /// The cache file of a soil: named by the fingerprint of everything its preparation depends on
 /// (the terrain file with its overrides, the files its reading read, the tire, this build).
