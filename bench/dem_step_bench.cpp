@@ -136,6 +136,19 @@ int main(int argc, char** argv) {
     } catch (const ConfigError&) {
       std::printf("# dem_step law_only_%d: not on this CPU\n", static_cast<int>(k));
     }
+  {
+    // the compute ceiling of the second core: the default kernel's law alone on both threads at
+    // once (each on a block of its own, in L1; the threads' rates added), over one thread alone
+    double one = 0.0, both = 0.0;
+    for (int rep = 0; rep < 3; ++rep) {
+      one = std::max(one, PairLawThroughput(PairKernel::kAuto, SoilContactLaw(soil), soil.diameter, 1.5e-5, 4000000));
+      double sum = 0.0;
+#pragma omp parallel num_threads(2) reduction(+ : sum)
+      sum += PairLawThroughput(PairKernel::kAuto, SoilContactLaw(soil), soil.diameter, 1.5e-5, 4000000);
+      both = std::max(both, sum);
+    }
+    std::printf("dem_step law_only_speedup_1_to_2 %.3f x\n", both / one);
+  }
   const DemSystem bed_a = ReferenceBed(soil);
   std::printf("dem_step bed_particles %d count\n", bed_a.num_alive());
   std::printf("dem_step bed_contacts %d count\n", bed_a.contacts());
