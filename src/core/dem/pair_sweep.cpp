@@ -98,7 +98,7 @@ void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int thre
 // ---------------------------------------------------------------------------------------------
 // the vector kernel
 
-constexpr int kBlock = 16;  // partners per block (a particle's half list holds 4-10 in a packed bed)
+constexpr int kBlock = 32;  // pairs per block (of one slot or of several consecutive ones)
 constexpr int kPad = 8;     // a block's lanes are computed in multiples of this (one AVX-512 vector)
 
 // The law's constants as the block loop reads them (the scalar law's, worked out the same way).
@@ -111,8 +111,7 @@ struct LawConstants {
 // The sweep's arrays (what the scalar kernel reads through ps and lists).
 struct SweepArrays {
   const HotParticle* hot;
-  Vector3d* f;
-  double *max_repulsion, *max_tension, *overlap;
+  PairSums* sums;
   const int *nbr_begin, *nbr_end, *nbr;
   TangentialHistory* hist;
   unsigned char* touching;
@@ -199,87 +198,149 @@ template <bool kCohesion>
   }
 }
 
-// The pairs of slot i: gathered block by block, the law on each block's lanes, the results
-// scattered in list order (the scalar kernel's order of sums and maxima).
-template <bool kCohesion>
-[[gnu::always_inline]] inline void SweepParticle(const LawConstants& c, const SweepArrays& a, int i, Block* b) {
+// Lanes [lane0, lane0 + m) of a block: slot i's pairs k0 .. k0 + m - 1 gathered (the partners' hot
+// records are only read during a sweep, so any number of slots may be gathered before any is
+// scattered).
+[[gnu::always_inline]] inline void GatherLanes(const SweepArrays& a, int i, int k0, int m, int lane0, Block* b) {
   const HotParticle& pi = a.hot[i];
   const double xi0 = pi.x[0], xi1 = pi.x[1], xi2 = pi.x[2];
   const double vi0 = pi.v[0], vi1 = pi.v[1], vi2 = pi.v[2];
   const double plastic_i = pi.plastic, adhesion_i = pi.adhesion_max;
-  double fi0 = 0.0, fi1 = 0.0, fi2 = 0.0;
-  double max_rep = a.max_repulsion[i], max_ten = a.max_tension[i], max_overlap = a.overlap[i];
-  for (int k0 = a.nbr_begin[i]; k0 < a.nbr_end[i]; k0 += kBlock) {
-    const int m = std::min(kBlock, a.nbr_end[i] - k0);
-    for (int l = 0; l < m; ++l) {
-      const HotParticle& pj = a.hot[a.nbr[k0 + l]];
-      b->rx[l] = xi0 - pj.x[0];
-      b->ry[l] = xi1 - pj.x[1];
-      b->rz[l] = xi2 - pj.x[2];
-      b->vx[l] = vi0 - pj.v[0];
-      b->vy[l] = vi1 - pj.v[1];
-      b->vz[l] = vi2 - pj.v[2];
-      b->psum[l] = plastic_i + pj.plastic;
-      b->amax[l] = std::min(adhesion_i, pj.adhesion_max);
-      const Vector3d& s = a.hist[k0 + l].spring;
-      b->sx[l] = s.x();
-      b->sy[l] = s.y();
-      b->sz[l] = s.z();
-    }
-    const int n = (m + kPad - 1) / kPad * kPad;
-    for (int l = m; l < n; ++l) {  // padding: apart by two diameters, at rest, no contact
-      b->rx[l] = b->ry[l] = b->rz[l] = 2.0 * c.D;
-      b->vx[l] = b->vy[l] = b->vz[l] = b->psum[l] = b->amax[l] = 0.0;
-      b->sx[l] = b->sy[l] = b->sz[l] = 0.0;
-    }
-    BlockLaw<kCohesion>(c, n, b);
-    for (int l = 0; l < m; ++l) {  // no branch: a lane without contact adds zeros
-      const int k = k0 + l, j = a.nbr[k];
-      max_overlap = std::max(max_overlap, b->ovl[l]);
-      a.overlap[j] = std::max(a.overlap[j], b->ovl[l]);
-      fi0 += b->fx[l];
-      fi1 += b->fy[l];
-      fi2 += b->fz[l];
-      Vector3d& fj = a.f[j];
-      fj.x() -= b->fx[l];
-      fj.y() -= b->fy[l];
-      fj.z() -= b->fz[l];
-      max_rep = std::max(max_rep, b->rep[l]);
-      max_ten = std::max(max_ten, b->ten[l]);
-      a.max_repulsion[j] = std::max(a.max_repulsion[j], b->rep[l]);
-      a.max_tension[j] = std::max(a.max_tension[j], b->ten[l]);
-      a.hist[k].spring = Vector3d(b->sx[l], b->sy[l], b->sz[l]);
-      a.touching[k] = static_cast<unsigned char>(b->contact[l] != 0.0);
-    }
+  for (int l = 0; l < m; ++l) {
+    const HotParticle& pj = a.hot[a.nbr[k0 + l]];
+    const int q = lane0 + l;
+    b->rx[q] = xi0 - pj.x[0];
+    b->ry[q] = xi1 - pj.x[1];
+    b->rz[q] = xi2 - pj.x[2];
+    b->vx[q] = vi0 - pj.v[0];
+    b->vy[q] = vi1 - pj.v[1];
+    b->vz[q] = vi2 - pj.v[2];
+    b->psum[q] = plastic_i + pj.plastic;
+    b->amax[q] = std::min(adhesion_i, pj.adhesion_max);
+    const Vector3d& sp = a.hist[k0 + l].spring;
+    b->sx[q] = sp.x();
+    b->sy[q] = sp.y();
+    b->sz[q] = sp.z();
   }
-  Vector3d& f = a.f[i];
-  f.x() += fi0;
-  f.y() += fi1;
-  f.z() += fi2;
-  a.max_repulsion[i] = max_rep;
-  a.max_tension[i] = max_ten;
-  a.overlap[i] = max_overlap;
 }
 
-// One slab: its listed slots in ascending order, then those added since the build. The partners
-// of the slot kAhead on are fetched into the cache while this one is computed: the slots of the
-// next cell rows along the grid's slower axes lie a plane of cells further on, and the block's
-// gather would wait for each of them (a quarter of the sweep's time without this).
+// Lanes [m, n) of a block: padding, apart by two diameters, at rest, no contact.
+[[gnu::always_inline]] inline void PadLanes(const LawConstants& c, int m, int n, Block* b) {
+  for (int l = m; l < n; ++l) {
+    b->rx[l] = b->ry[l] = b->rz[l] = 2.0 * c.D;
+    b->vx[l] = b->vy[l] = b->vz[l] = b->psum[l] = b->amax[l] = 0.0;
+    b->sx[l] = b->sy[l] = b->sz[l] = 0.0;
+  }
+}
+
+// What one slot's sweep carries from block to block: its force sum and its maxima.
+struct SlotSums {
+  double f0 = 0.0, f1 = 0.0, f2 = 0.0;
+  double max_rep, max_ten, max_overlap;
+  explicit SlotSums(const PairSums& s) : max_rep(s.max_repulsion), max_ten(s.max_tension), max_overlap(s.overlap) {}
+  void Into(PairSums* s) const {
+    s->f[0] += f0;
+    s->f[1] += f1;
+    s->f[2] += f2;
+    s->max_repulsion = max_rep;
+    s->max_tension = max_ten;
+    s->overlap = max_overlap;
+  }
+};
+
+// The results of lanes [lane0, lane0 + m) (slot i's pairs k0 ...) scattered in list order, the
+// scalar kernel's order of sums and maxima. No branch: a lane without contact adds zeros.
+[[gnu::always_inline]] inline void ScatterLanes(const SweepArrays& a, int k0, int m, int lane0, const Block* b,
+                                                SlotSums* si) {
+  for (int l = 0; l < m; ++l) {
+    const int q = lane0 + l, k = k0 + l, j = a.nbr[k];
+    PairSums& sj = a.sums[j];
+    si->max_overlap = std::max(si->max_overlap, b->ovl[q]);
+    sj.overlap = std::max(sj.overlap, b->ovl[q]);
+    si->f0 += b->fx[q];
+    si->f1 += b->fy[q];
+    si->f2 += b->fz[q];
+    sj.f[0] -= b->fx[q];
+    sj.f[1] -= b->fy[q];
+    sj.f[2] -= b->fz[q];
+    si->max_rep = std::max(si->max_rep, b->rep[q]);
+    si->max_ten = std::max(si->max_ten, b->ten[q]);
+    sj.max_repulsion = std::max(sj.max_repulsion, b->rep[q]);
+    sj.max_tension = std::max(sj.max_tension, b->ten[q]);
+    a.hist[k].spring = Vector3d(b->sx[q], b->sy[q], b->sz[q]);
+    a.touching[k] = static_cast<unsigned char>(b->contact[q] != 0.0);
+  }
+}
+
+// A slot with more pairs than a block holds: its pairs block by block on their own.
+template <bool kCohesion>
+[[gnu::always_inline]] inline void SweepLongSlot(const LawConstants& c, const SweepArrays& a, int i, Block* b) {
+  SlotSums si(a.sums[i]);
+  for (int k0 = a.nbr_begin[i]; k0 < a.nbr_end[i]; k0 += kBlock) {
+    const int m = std::min(kBlock, a.nbr_end[i] - k0);
+    GatherLanes(a, i, k0, m, 0, b);
+    const int n = (m + kPad - 1) / kPad * kPad;
+    PadLanes(c, m, n, b);
+    BlockLaw<kCohesion>(c, n, b);
+    ScatterLanes(a, k0, m, 0, b, &si);
+  }
+  si.Into(&a.sums[i]);
+}
+
+// One slab: its listed slots in ascending order, then those added since the build. Consecutive
+// slots share a block (a slot's half list holds 4-10 pairs in a packed bed: one slot per block
+// would leave the law one vector, its sqrt and division chain waiting on each other): their pairs
+// are gathered lane after lane, the law runs once over the block, and the slots are scattered one
+// after the other in their order, each as it would be alone (a slot's sums are read when it is
+// scattered, after those of the slots before it). The partners of the slot kAhead on are fetched
+// into the cache while this one is gathered: the slots of the next cell rows along the grid's
+// slower axes lie a plane of cells further on, and the gather and scatter would wait for each of
+// them.
 template <bool kCohesion>
 [[gnu::always_inline]] inline void SweepSlabOf(const LawConstants& c, const SweepArrays& a, const SlotState* state,
                                                int begin, int end, const std::vector<int>& added) {
   constexpr int kAhead = 3;
   Block b;
+  int slots[kBlock];  // the block's slots, in order (one without pairs takes its turn too)
+  int lanes = 0, count = 0;
+  auto flush = [&]() __attribute__((always_inline)) {
+    if (lanes == 0) return;
+    const int n = (lanes + kPad - 1) / kPad * kPad;
+    PadLanes(c, lanes, n, &b);
+    BlockLaw<kCohesion>(c, n, &b);
+    int lane0 = 0;
+    for (int s = 0; s < count; ++s) {
+      const int i = slots[s], k0 = a.nbr_begin[i], m = a.nbr_end[i] - k0;
+      SlotSums si(a.sums[i]);
+      ScatterLanes(a, k0, m, lane0, &b, &si);
+      si.Into(&a.sums[i]);
+      lane0 += m;
+    }
+    lanes = count = 0;
+  };
+  auto sweep = [&](int i) __attribute__((always_inline)) {
+    const int m = a.nbr_end[i] - a.nbr_begin[i];
+    if (m > kBlock) {  // rare: after the slots before it, on its own
+      flush();
+      SweepLongSlot<kCohesion>(c, a, i, &b);
+      return;
+    }
+    if (lanes + m > kBlock || count == kBlock) flush();
+    GatherLanes(a, i, a.nbr_begin[i], m, lanes, &b);
+    slots[count++] = i;
+    lanes += m;
+  };
   for (int i = begin; i < end; ++i) {
     if (i + kAhead < end)
       for (int k = a.nbr_begin[i + kAhead]; k < a.nbr_end[i + kAhead]; ++k) {
         const int j = a.nbr[k];
         __builtin_prefetch(&a.hot[j], 0, 3);
-        __builtin_prefetch(&a.f[j], 1, 3);
+        __builtin_prefetch(&a.sums[j], 1, 3);
       }
-    if (state[i] == SlotState::kListed) SweepParticle<kCohesion>(c, a, i, &b);
+    if (state[i] == SlotState::kListed) sweep(i);
   }
-  for (const int i : added) SweepParticle<kCohesion>(c, a, i, &b);
+  for (const int i : added) sweep(i);
+  flush();
 }
 
 [[gnu::always_inline]] inline void SweepSlabBody(const LawConstants& c, const SweepArrays& a, const SlotState* state,
@@ -342,11 +403,23 @@ LawConstants ConstantsOf(const SoilContactLaw& law, double diameter, double dt) 
 void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, double dt, int threads,
                  ParticleStore* ps, NeighbourList* lists) {
   const int n = ps->slots();
-  if (static_cast<int>(ps->hot.size()) != n) ps->hot.resize(n);  // only when slots were appended
+  if (static_cast<int>(ps->hot.size()) != n || static_cast<int>(ps->sums.size()) != n) {  // slots appended
+    ps->hot.resize(n);
+    ps->sums.resize(n);
+  }
   HotParticle* hot = ps->hot.data();
+  PairSums* sums = ps->sums.data();
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (int i = 0; i < n; ++i) {
     HotParticle& h = hot[i];
+    PairSums& s = sums[i];
+    const Vector3d& fi = ps->f[i];
+    s.f[0] = fi.x();
+    s.f[1] = fi.y();
+    s.f[2] = fi.z();
+    s.max_repulsion = ps->max_repulsion[i];
+    s.max_tension = ps->max_tension[i];
+    s.overlap = ps->overlap[i];
     const Vector3d& xi = ps->x[i];
     const Vector3d& vi = ps->v[i];
     h.x[0] = xi.x();
@@ -360,10 +433,7 @@ void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, 
   }
   const LawConstants c = ConstantsOf(law, diameter, dt);
   const SweepArrays a{hot,
-                      ps->f.data(),
-                      ps->max_repulsion.data(),
-                      ps->max_tension.data(),
-                      ps->overlap.data(),
+                      sums,
                       lists->list_begin().data(),
                       lists->list_end().data(),
                       lists->partners().data(),
@@ -375,6 +445,14 @@ void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, 
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int sl = colour; sl < ns; sl += 2)
       slab(c, a, state, lists->slab_start(sl), lists->slab_start(sl + 1), lists->slab_added(sl));
+  }
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int i = 0; i < n; ++i) {
+    const PairSums& s = sums[i];
+    ps->f[i] = Vector3d(s.f[0], s.f[1], s.f[2]);
+    ps->max_repulsion[i] = s.max_repulsion;
+    ps->max_tension[i] = s.max_tension;
+    ps->overlap[i] = s.overlap;
   }
 }
 

@@ -87,18 +87,19 @@ void ParticleStore::Permute(const std::vector<int>& order) {
 size_t ParticleStore::MemoryBytes() const {
   auto bytes = [](const auto& a) { return a.capacity() * sizeof(a[0]); };
   return bytes(x) + bytes(v) + bytes(f) + bytes(x_built) + bytes(plastic) + bytes(adhesion_max) +
-         bytes(max_repulsion) + bytes(max_tension) + bytes(overlap) + bytes(state) + bytes(held) + bytes(id_of_slot) + bytes(hot) +
+         bytes(max_repulsion) + bytes(max_tension) + bytes(overlap) + bytes(state) + bytes(held) + bytes(id_of_slot) + bytes(hot) + bytes(sums) +
          bytes(ids_) + bytes(free_slots_);
 }
 
 template <class Ar>
 void ParticleStore::Io(Ar& ar) {
   ar.Tag("particles");
-  // (not `hot`: the pair kernels' scratch, packed from these arrays before every sweep)
+  // (not `hot` nor `sums`: the pair kernels' scratch, packed from these arrays before every sweep)
   ar(x, v, f, x_built, plastic, adhesion_max, max_repulsion, max_tension, overlap, state, held, id_of_slot, ids_,
      free_slots_, removed_);
   if constexpr (Ar::kLoading) {
     hot.clear();
+    sums.clear();
     const size_t n = x.size();
     for (size_t len : {v.size(), f.size(), x_built.size(), plastic.size(), adhesion_max.size(), max_repulsion.size(),
                        max_tension.size(), overlap.size(), state.size(), held.size(), id_of_slot.size()})

@@ -41,7 +41,7 @@ void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threa
                 NeighbourList* lists, PairKernel kernel = PairKernel::kAuto);
 
 /// The benchmark's ceiling: pairs per second of the law alone on `kernel` (vector instances only),
-/// on one block of 16 pairs in contact that stays in L1 (no gather, no scatter, no memory), over
+/// on one block of 32 pairs in contact that stays in L1 (no gather, no scatter, no memory), over
 /// `repetitions` evaluations on one thread.
 double PairLawThroughput(PairKernel kernel, const SoilContactLaw& law, double diameter, double dt, long repetitions);
 

@@ -47,6 +47,15 @@ struct alignas(64) HotParticle {
 };
 static_assert(sizeof(HotParticle) == 64, "one cache line");
 
+/// What the pair sweep adds to a partner, in one cache line: the vector kernels sum into it
+/// (copied from f, max_repulsion, max_tension and overlap before each sweep and back after it), so
+/// that a partner's results cost one line and not four.
+struct alignas(64) PairSums {
+  double f[3];
+  double max_repulsion, max_tension, overlap;
+};
+static_assert(sizeof(PairSums) == 64, "one cache line");
+
 class ParticleStore {
  public:
   static constexpr int kNoId = -1;
@@ -65,6 +74,9 @@ class ParticleStore {
   /// x, v, plastic and adhesion_max of every slot, packed by the vector pair kernels before each
   /// sweep (sized to slots() there; a scratch copy, never the state)
   std::vector<HotParticle> hot;
+  /// f, max_repulsion, max_tension and overlap of every slot while a vector kernel sweeps (its
+  /// scratch as `hot` is)
+  std::vector<PairSums> sums;
 
   int slots() const { return static_cast<int>(x.size()); }
   bool live(int s) const { return state[s] != SlotState::kFree; }
