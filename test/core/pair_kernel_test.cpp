@@ -204,6 +204,54 @@ TEST(PairKernel, ADemRunOnTheVectorKernelIsTheScalarRunBitForBit) {
   }
 }
 
+// Slots without a pair before slots with pairs (a block holds the pairs of consecutive slots and
+// takes each slot in its turn, a slot without pairs too): a sparse lattice of 300 particles, those
+// of its last row along x each with a partner in contact beside it. Each slot's force starts at -0:
+// the scalar kernel adds its zero pair sum (+0) to it, so a slot the vector kernel skipped would
+// keep -0.
+TEST(PairKernel, SlotsWithoutPairsTakeTheirTurnInABlock) {
+  const SoilParams soil = Nominal();
+  const SoilContactLaw law(soil);
+  const double D = soil.diameter, dt = 2e-5;
+  ParticleStore ps;
+  bool appended = false;
+  for (int p = 0; p < 300; ++p) {
+    const Vector3d c(3.0 * D * (p % 10), 3.0 * D * ((p / 10) % 10), 3.0 * D * (p / 100));
+    ps.Add(c, Vector3d(0.01 * p, 0.0, 0.0), Vector3d::Zero(), 0.0, SlotState::kListed, &appended);
+    if (p % 10 == 9)  // the last row along x: its slots come after a run of slots without pairs
+      ps.Add(c + Vector3d(0.97 * D, 0.0, 0.0), Vector3d::Zero(), Vector3d::Zero(), 0.0, SlotState::kListed, &appended);
+  }
+  NeighbourList lists(1.5 * D, 2);
+  lists.Build(&ps, 1);
+  int empty_run = 0, longest_empty_run = 0, pairs = 0;
+  for (int i = 0; i < ps.slots(); ++i) {
+    const int m = lists.end(i) - lists.begin(i);
+    pairs += m;
+    empty_run = m == 0 ? empty_run + 1 : 0;
+    longest_empty_run = std::max(longest_empty_run, empty_run);
+  }
+  EXPECT_EQ(pairs, 30);
+  EXPECT_GT(longest_empty_run, 40) << "more slots without pairs in a row than a block holds slots (32)";
+  auto sweep = [&](PairKernel kernel, int threads) {
+    ParticleStore p = ps;
+    NeighbourList l = lists;
+    for (int i = 0; i < p.slots(); ++i) {
+      p.f[i] = Vector3d(-0.0, -0.0, -0.0);
+      p.max_repulsion[i] = p.max_tension[i] = p.overlap[i] = 0.0;
+    }
+    SweepPairs(law, D, dt, threads, &p, &l, kernel);
+    SweepOut o{p.f, {}, p.max_repulsion, p.max_tension, p.overlap, l.touching()};
+    for (const TangentialHistory& h : l.histories()) o.spring.push_back(h.spring);
+    return o;
+  };
+  const SweepOut ref = sweep(PairKernel::kScalar, 1);
+  int negative_zero = 0;
+  for (const Vector3d& f : ref.f) negative_zero += f.x() == 0.0 && std::signbit(f.x());
+  EXPECT_EQ(negative_zero, 0) << "the scalar kernel adds +0 to a slot without pairs";
+  for (PairKernel kernel : VectorKernels())
+    for (int threads : {1, 2}) ExpectSameBits(ref, sweep(kernel, threads), PairKernelName(kernel));
+}
+
 TEST(PairKernel, AutoTakesTheBestInstanceTheCpuHas) {
   const PairKernel k = ResolvePairKernel(PairKernel::kAuto);
   EXPECT_NE(k, PairKernel::kAuto);

@@ -304,7 +304,7 @@ template <bool kCohesion>
   int slots[kBlock];  // the block's slots, in order (one without pairs takes its turn too)
   int lanes = 0, count = 0;
   auto flush = [&]() __attribute__((always_inline)) {
-    if (lanes == 0) return;
+    if (count == 0) return;
     const int n = (lanes + kPad - 1) / kPad * kPad;
     PadLanes(c, lanes, n, &b);
     BlockLaw<kCohesion>(c, n, &b);
