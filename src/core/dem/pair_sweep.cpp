@@ -295,7 +295,8 @@ template <bool kCohesion>
 // scattered, after those of the slots before it). The partners of the slot kAhead on are fetched
 // into the cache while this one is gathered: the slots of the next cell rows along the grid's
 // slower axes lie a plane of cells further on, and the gather and scatter would wait for each of
-// them.
+// them. (The two lambdas are always inlined: a lambda does not take its caller's target, and
+// compiled on its own it would run the law on the baseline's SSE2 in every instance.)
 template <bool kCohesion>
 [[gnu::always_inline]] inline void SweepSlabOf(const LawConstants& c, const SweepArrays& a, const SlotState* state,
                                                int begin, int end, const std::vector<int>& added) {

@@ -6,10 +6,11 @@
 // Two kernels compute the same law:
 //  - the scalar one, the soil law's per-pair functions (SoilContactLaw::Normal, Tangential) one
 //    contact after the other: the reference;
-//  - the vector one: a particle's partners in blocks (structure of arrays gathered from each
-//    partner's one-cache-line hot record and from the contact histories), the law written without
-//    branches over the block's lanes so that the compiler vectorises it, then the forces scattered
-//    in the scalar kernel's order. It is compiled three times, for x86-64-v4 (AVX-512), x86-64-v3
+//  - the vector one: the pairs of consecutive particles in blocks of 32 lanes (structure of arrays
+//    gathered from each partner's one-cache-line hot record and from the contact histories), the
+//    law written without branches over the block's lanes so that the compiler vectorises it, then
+//    the forces scattered particle after particle in the scalar kernel's order, into one
+//    cache-line record of sums per partner (ps->sums, copied back afterwards). It is compiled three times, for x86-64-v4 (AVX-512), x86-64-v3
 //    (AVX2, FMA) and the x86-64 baseline (SSE2), and the best the CPU has is taken at run time
 //    (kAuto). Floating-point contraction is off in that file and every sum is associated as
 //    Eigen's are, so all of its instances give the scalar kernel's results bit for bit.
