@@ -152,17 +152,24 @@ void DemSystem::Rebuild() {
   ++builds_;
 }
 
-void DemSystem::ComputeForces() {
-  const int n = ps_.slots();
-  const Vector3d weight = mass_ * gravity_;
+void DemSystem::SumForces(bool packed) {
   const int T = Threads();
+  if (!packed) {
+    const int n = ps_.slots();
+    const Vector3d weight = mass_ * gravity_;
+    ps_.SizeScratch();
 #pragma omp parallel for schedule(static) num_threads(T)
-  for (int i = 0; i < n; ++i) {
-    ps_.f[i] = ps_.live(i) ? weight : Vector3d::Zero();
-    ps_.max_repulsion[i] = ps_.max_tension[i] = ps_.overlap[i] = 0.0;
+    for (int i = 0; i < n; ++i) ps_.PackFresh(i, ps_.live(i) ? weight : Vector3d::Zero());
   }
-  SweepPairs(law_, soil_.diameter, dt_, T, &ps_, &lists_, settings_.pair_kernel);
+  SweepPacked(law_, soil_.diameter, dt_, T, &ps_, &lists_, settings_.pair_kernel);
   ledger_.wall_power = walls_.Compute(&ps_, dt_, T);
+}
+
+void DemSystem::ComputeForces() {
+  SumForces(false);
+  const int n = ps_.slots();
+#pragma omp parallel for schedule(static) num_threads(Threads())
+  for (int i = 0; i < n; ++i) ps_.Unpack(i);
 }
 
 void DemSystem::Step() {
@@ -173,33 +180,46 @@ void DemSystem::Step() {
   std::vector<Vector3d>& x = ps_.x;
   std::vector<Vector3d>& v = ps_.v;
   const std::vector<Vector3d>& f = ps_.f;
+  const Vector3d weight = mass_ * gravity_;
   double max_disp2 = 0.0;
   int tripped = n;  // the lowest slot a watchdog trips on
+  // the drift, each slot then packed for the force evaluation (while it is in the cache: one
+  // pass over the particles fewer; a neighbour build below permutes the slots and packs them again)
+  ps_.SizeScratch();
 #pragma omp parallel for schedule(static) num_threads(Threads()) reduction(max : max_disp2) reduction(min : tripped)
   for (int i = 0; i < n; ++i) {
-    if (!ps_.live(i)) continue;
+    if (!ps_.live(i)) {
+      ps_.PackFresh(i, Vector3d::Zero());
+      continue;
+    }
     if (!ps_.held[i]) {
       v[i] += h * inv_m * f[i];
       x[i] += dt_ * v[i];
       max_disp2 = std::max(max_disp2, (x[i] - ps_.x_built[i]).squaredNorm());
     }
     if (StateTrips(ps_, i, dt_, half_skin)) tripped = std::min(tripped, i);
+    ps_.PackFresh(i, weight);
   }
   time_ += dt_;
   ++step_;
   if (tripped < n) ReportStateTrip(ps_, tripped, dt_, half_skin, step_, time_);
   walls_.UpdateVertices();  // the walls' poses were set for this step from outside
-  if (rebuild_ || max_disp2 > half_skin * half_skin || walls_.MaxWallDisplacement(false) > half_skin)
+  bool packed = true;
+  if (rebuild_ || max_disp2 > half_skin * half_skin || walls_.MaxWallDisplacement(false) > half_skin) {
     Rebuild();  // the particles or a slow wall moved half the skin
-  else if (walls_.NeedsBuild(std::sqrt(max_disp2)))  // a fast wall moved: only the wall candidates
+    packed = false;
+  } else if (walls_.NeedsBuild(std::sqrt(max_disp2))) {  // a fast wall moved: only the wall candidates
     walls_.Build(ps_, Threads(), std::sqrt(max_disp2));
+  }
   const double power_before = ledger_.wall_power;
-  ComputeForces();
+  SumForces(packed);
   ledger_.wall_work += h * (power_before + ledger_.wall_power);  // trapezoidal
   const double overlap_limit = settings_.max_overlap * soil_.diameter;
 #pragma omp parallel for schedule(static) num_threads(Threads()) reduction(min : tripped)
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < n; ++i) {
+    ps_.Unpack(i);
     if (ps_.live(i) && OverlapTrips(ps_, i, overlap_limit)) tripped = std::min(tripped, i);
+  }
   if (tripped < n) ReportOverlapTrip(ps_, tripped, soil_.diameter, settings_.max_overlap, step_, time_);
   const bool ledger = plastic_ledger_;
   if (ledger && static_cast<int>(plastic_rec_.size()) < n) {

@@ -151,6 +151,9 @@ void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
         cap[i] = i < live ? end[i] + slack_ : end[i];
         total = cap[i];
       }
+      ReserveOnHugePages(&nbr, total);  // (see huge_pages.h)
+      ReserveOnHugePages(&hist, total);
+      ReserveOnHugePages(&touching, total);
       nbr.assign(total, -1);
       hist.assign(total, TangentialHistory());
       touching.assign(total, 0);

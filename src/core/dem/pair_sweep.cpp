@@ -24,12 +24,9 @@ void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int thre
   const double D = diameter, D2 = D * D;
   std::vector<Vector3d>& x = ps->x;
   std::vector<Vector3d>& v = ps->v;
-  std::vector<Vector3d>& f = ps->f;
-  std::vector<double>& plastic = ps->plastic;
-  std::vector<double>& adhesion_max = ps->adhesion_max;
-  std::vector<double>& max_repulsion = ps->max_repulsion;
-  std::vector<double>& max_tension = ps->max_tension;
-  std::vector<double>& overlap_of = ps->overlap;
+  const std::vector<double>& plastic = ps->plastic;
+  const std::vector<double>& adhesion_max = ps->adhesion_max;
+  PairSums* sums = ps->sums.data();
   const std::vector<int>& nbr_begin = lists->list_begin();
   const std::vector<int>& nbr_end = lists->list_end();
   const std::vector<int>& nbr = lists->partners();
@@ -39,7 +36,8 @@ void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int thre
     const Vector3d xi = x[i], vi = v[i];
     const double pi = plastic[i], ai = adhesion_max[i];
     Vector3d fi = Vector3d::Zero();
-    double max_rep = max_repulsion[i], max_ten = max_tension[i], max_overlap = overlap_of[i];
+    PairSums& si = sums[i];
+    double max_rep = si.max_repulsion, max_ten = si.max_tension, max_overlap = si.overlap;
     for (int k = nbr_begin[i]; k < nbr_end[i]; ++k) {
       const int j = nbr[k];
       const Vector3d r = xi - x[j];
@@ -53,8 +51,9 @@ void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int thre
       }
       const double dist = std::sqrt(r2);
       const double overlap = D - dist;
+      PairSums& sj = sums[j];
       max_overlap = std::max(max_overlap, overlap);
-      overlap_of[j] = std::max(overlap_of[j], overlap);
+      sj.overlap = std::max(sj.overlap, overlap);
       // effective penetration: the overlap less both particles' plastic deformation
       const double d = overlap - (pi + plastic[j]);
       if (!(d > 0.0) || dist <= 0.0) {
@@ -71,17 +70,21 @@ void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int thre
       const Vector3d vt = vr - vn * nrm;
       const Vector3d fc = fn.Total() * nrm + law.Tangential(nrm, vt, fn.repulsion, dt, &hist[k]);
       fi += fc;
-      f[j] -= fc;
+      sj.f[0] -= fc.x();
+      sj.f[1] -= fc.y();
+      sj.f[2] -= fc.z();
       max_rep = std::max(max_rep, fn.repulsion);
       max_ten = std::max(max_ten, -fn.adhesion);
-      max_repulsion[j] = std::max(max_repulsion[j], fn.repulsion);
-      max_tension[j] = std::max(max_tension[j], -fn.adhesion);
+      sj.max_repulsion = std::max(sj.max_repulsion, fn.repulsion);
+      sj.max_tension = std::max(sj.max_tension, -fn.adhesion);
       touching[k] = 1;
     }
-    f[i] += fi;
-    max_repulsion[i] = max_rep;
-    max_tension[i] = max_ten;
-    overlap_of[i] = max_overlap;
+    si.f[0] += fi.x();
+    si.f[1] += fi.y();
+    si.f[2] += fi.z();
+    si.max_repulsion = max_rep;
+    si.max_tension = max_ten;
+    si.overlap = max_overlap;
   };
   const std::vector<SlotState>& state = ps->state;
   const int ns = lists->num_slabs();
@@ -403,38 +406,9 @@ LawConstants ConstantsOf(const SoilContactLaw& law, double diameter, double dt) 
 
 void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, double dt, int threads,
                  ParticleStore* ps, NeighbourList* lists) {
-  const int n = ps->slots();
-  if (static_cast<int>(ps->hot.size()) != n || static_cast<int>(ps->sums.size()) != n) {  // slots appended
-    ps->hot.resize(n);
-    ps->sums.resize(n);
-  }
-  HotParticle* hot = ps->hot.data();
-  PairSums* sums = ps->sums.data();
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int i = 0; i < n; ++i) {
-    HotParticle& h = hot[i];
-    PairSums& s = sums[i];
-    const Vector3d& fi = ps->f[i];
-    s.f[0] = fi.x();
-    s.f[1] = fi.y();
-    s.f[2] = fi.z();
-    s.max_repulsion = ps->max_repulsion[i];
-    s.max_tension = ps->max_tension[i];
-    s.overlap = ps->overlap[i];
-    const Vector3d& xi = ps->x[i];
-    const Vector3d& vi = ps->v[i];
-    h.x[0] = xi.x();
-    h.x[1] = xi.y();
-    h.x[2] = xi.z();
-    h.v[0] = vi.x();
-    h.v[1] = vi.y();
-    h.v[2] = vi.z();
-    h.plastic = ps->plastic[i];
-    h.adhesion_max = ps->adhesion_max[i];
-  }
   const LawConstants c = ConstantsOf(law, diameter, dt);
-  const SweepArrays a{hot,
-                      sums,
+  const SweepArrays a{ps->hot.data(),
+                      ps->sums.data(),
                       lists->list_begin().data(),
                       lists->list_end().data(),
                       lists->partners().data(),
@@ -446,14 +420,6 @@ void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, 
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int sl = colour; sl < ns; sl += 2)
       slab(c, a, state, lists->slab_start(sl), lists->slab_start(sl + 1), lists->slab_added(sl));
-  }
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int i = 0; i < n; ++i) {
-    const PairSums& s = sums[i];
-    ps->f[i] = Vector3d(s.f[0], s.f[1], s.f[2]);
-    ps->max_repulsion[i] = s.max_repulsion;
-    ps->max_tension[i] = s.max_tension;
-    ps->overlap[i] = s.overlap;
   }
 }
 
@@ -486,14 +452,32 @@ const char* PairKernelName(PairKernel kernel) {
   }
 }
 
-void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
-                NeighbourList* lists, PairKernel kernel) {
+void SweepPacked(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
+                 NeighbourList* lists, PairKernel kernel) {
+  DM_DEMAND(static_cast<int>(ps->hot.size()) == ps->slots() && static_cast<int>(ps->sums.size()) == ps->slots());
   switch (kernel == PairKernel::kAuto ? ResolvePairKernel(kernel) : kernel) {
     case PairKernel::kVectorAvx512: return SweepVector(SweepSlabAvx512, law, diameter, dt, threads, ps, lists);
     case PairKernel::kVectorAvx2: return SweepVector(SweepSlabAvx2, law, diameter, dt, threads, ps, lists);
     case PairKernel::kVectorBaseline: return SweepVector(SweepSlabBaseline, law, diameter, dt, threads, ps, lists);
     default: return SweepScalar(law, diameter, dt, threads, ps, lists);
   }
+}
+
+void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
+                NeighbourList* lists, PairKernel kernel) {
+  const int n = ps->slots();
+  ps->SizeScratch();
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int i = 0; i < n; ++i) {
+    ps->PackFresh(i, ps->f[i]);
+    PairSums& s = ps->sums[i];
+    s.max_repulsion = ps->max_repulsion[i];
+    s.max_tension = ps->max_tension[i];
+    s.overlap = ps->overlap[i];
+  }
+  SweepPacked(law, diameter, dt, threads, ps, lists, kernel);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int i = 0; i < n; ++i) ps->Unpack(i);
 }
 
 double PairLawThroughput(PairKernel kernel, const SoilContactLaw& law, double diameter, double dt, long repetitions) {

@@ -261,8 +261,9 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
   const double D = diameter_;
   const Vector3d xi = ps->x[i], vi = ps->v[i];
   const double pi = ps->plastic[i], ai = ps->adhesion_max[i];
-  Vector3d f = ps->f[i];
-  double max_rep = ps->max_repulsion[i], max_ten = ps->max_tension[i], max_overlap = ps->overlap[i];
+  PairSums& si = ps->sums[i];
+  Vector3d f(si.f[0], si.f[1], si.f[2]);
+  double max_rep = si.max_repulsion, max_ten = si.max_tension, max_overlap = si.overlap;
   auto tri_at = [&](int t) -> const WallTri& { return tris_[fresh ? fresh_tris[t] : tri_of_slot_[t]]; };
   int t = t_begin;
   for (int w = 0; w < W; ++w) {
@@ -311,10 +312,12 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
     sum[w].normal += fn.Total();
     ++sum[w].contacts;
   }
-  ps->f[i] = f;
-  ps->max_repulsion[i] = max_rep;
-  ps->max_tension[i] = max_ten;
-  ps->overlap[i] = max_overlap;
+  si.f[0] = f.x();
+  si.f[1] = f.y();
+  si.f[2] = f.z();
+  si.max_repulsion = max_rep;
+  si.max_tension = max_ten;
+  si.overlap = max_overlap;
 }
 
 double WallContacts::SumWrenches(int chunks) {

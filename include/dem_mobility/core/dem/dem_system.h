@@ -164,7 +164,11 @@ class DemSystem {
 
  private:
   void Rebuild();
+  /// The forces, maxima and overlaps (f, max_repulsion, max_tension, overlap) at the present state.
   void ComputeForces();
+  /// Sums the pair and wall forces into the slots' sums (ps_.sums); `packed`: the step's drift
+  /// packed every slot already (else they are packed here).
+  void SumForces(bool packed);
   /// Adds the step's plastic changes' energy to the ledger (set_plastic_ledger).
   void PlasticExchange();
   /// The threads a pass runs on (settings_.serial_below).

@@ -10,8 +10,9 @@
 //    gathered from each partner's one-cache-line hot record and from the contact histories), the
 //    law written without branches over the block's lanes so that the compiler vectorises it, then
 //    the forces scattered particle after particle in the scalar kernel's order, into one
-//    cache-line record of sums per partner (ps->sums, copied back afterwards). It is compiled three times, for x86-64-v4 (AVX-512), x86-64-v3
-//    (AVX2, FMA) and the x86-64 baseline (SSE2), and the best the CPU has is taken at run time
+//    cache-line record of sums per partner (ps->sums; the scalar kernel sums into it too). It is
+//    compiled three times, for x86-64-v4 (AVX-512), x86-64-v3 (AVX2, FMA) and the x86-64 baseline
+//    (SSE2), and the best the CPU has is taken at run time
 //    (kAuto). Floating-point contraction is off in that file and every sum is associated as
 //    Eigen's are, so all of its instances give the scalar kernel's results bit for bit.
 #pragma once
@@ -35,9 +36,16 @@ PairKernel ResolvePairKernel(PairKernel requested);
 /// "vector-avx512", "vector-avx2", "vector-baseline", "scalar" (kAuto: what it resolves to).
 const char* PairKernelName(PairKernel kernel);
 
-/// Adds the pair forces to ps->f (set beforehand to the weights) and records each particle's
-/// largest repulsion, tension and overlap (reset beforehand); updates the contact histories. The
-/// vector kernels first pack each slot's hot record (ps->hot).
+/// Adds the pair forces to each slot's sums (ps->sums: its force and its largest repulsion, tension
+/// and overlap, started beforehand) and updates the contact histories. The slots' records are
+/// packed beforehand (ParticleStore::SizeScratch and PackFresh: the vector kernels gather from
+/// ps->hot; the scalar one reads the per-slot arrays).
+void SweepPacked(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
+                 NeighbourList* lists, PairKernel kernel = PairKernel::kAuto);
+
+/// SweepPacked on the per-slot arrays: adds the pair forces to ps->f and updates each particle's
+/// largest repulsion, tension and overlap in max_repulsion, max_tension and overlap (packs the
+/// slots from them, sweeps, and unpacks).
 void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
                 NeighbourList* lists, PairKernel kernel = PairKernel::kAuto);
 

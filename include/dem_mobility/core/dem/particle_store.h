@@ -8,6 +8,8 @@
 #include <limits>
 #include <vector>
 
+#include "dem_mobility/core/common/huge_pages.h"
+
 namespace dem_mobility::core {
 
 /// What a slot holds.
@@ -28,15 +30,6 @@ struct IdRecord {
   State state = State::kGone;
   int slot = -1;
 };
-
-/// Permutes a per-slot array of `width` entries per slot: new slot s takes old slot order[s].
-template <class T>
-void PermuteSlots(std::vector<T>* v, const std::vector<int>& order, size_t width) {
-  const std::vector<T> old = *v;
-  for (size_t s = 0; s < order.size(); ++s)
-    std::copy(old.begin() + static_cast<size_t>(order[s]) * width,
-              old.begin() + static_cast<size_t>(order[s] + 1) * width, v->begin() + s * width);
-}
 
 /// What the pair sweep reads of a partner, packed into one cache line (written before each sweep
 /// from the per-slot arrays below; the vector kernels gather from it).
@@ -71,14 +64,50 @@ class ParticleStore {
   /// 1: held in place (zero velocity, not integrated; its contacts still act on its neighbours)
   std::vector<unsigned char> held;
   std::vector<int> id_of_slot;  ///< the ID whose (last) state the slot holds, or kNoId
-  /// x, v, plastic and adhesion_max of every slot, packed by the vector pair kernels before each
-  /// sweep (sized to slots() there; a scratch copy, never the state)
+  /// x, v, plastic and adhesion_max of every slot, packed before each force evaluation (the vector
+  /// pair kernels gather from it; a scratch copy, never the state)
   std::vector<HotParticle> hot;
-  /// f, max_repulsion, max_tension and overlap of every slot while a vector kernel sweeps (its
-  /// scratch as `hot` is)
+  /// f, max_repulsion, max_tension and overlap of every slot while the forces are summed: the pair
+  /// kernels and the walls add into it, and it is unpacked into those arrays afterwards (scratch
+  /// as `hot` is)
   std::vector<PairSums> sums;
 
   int slots() const { return static_cast<int>(x.size()); }
+  /// Sizes `hot` and `sums` to the slots (on huge pages when new).
+  void SizeScratch() {
+    const size_t n = x.size();
+    if (hot.size() == n && sums.size() == n) return;
+    ReserveOnHugePages(&hot, n);
+    ReserveOnHugePages(&sums, n);
+    hot.resize(n);
+    sums.resize(n);
+  }
+  /// Packs slot s for a sweep: its hot record from x, v, plastic and adhesion_max, its sums started
+  /// at force `f0` with zero maxima (the force evaluation's start: a live slot's weight, or zero).
+  void PackFresh(int s, const Eigen::Vector3d& f0) {
+    HotParticle& h = hot[s];
+    h.x[0] = x[s].x();
+    h.x[1] = x[s].y();
+    h.x[2] = x[s].z();
+    h.v[0] = v[s].x();
+    h.v[1] = v[s].y();
+    h.v[2] = v[s].z();
+    h.plastic = plastic[s];
+    h.adhesion_max = adhesion_max[s];
+    PairSums& r = sums[s];
+    r.f[0] = f0.x();
+    r.f[1] = f0.y();
+    r.f[2] = f0.z();
+    r.max_repulsion = r.max_tension = r.overlap = 0.0;
+  }
+  /// Slot s's sums back into f, max_repulsion, max_tension and overlap.
+  void Unpack(int s) {
+    const PairSums& r = sums[s];
+    f[s] = Eigen::Vector3d(r.f[0], r.f[1], r.f[2]);
+    max_repulsion[s] = r.max_repulsion;
+    max_tension[s] = r.max_tension;
+    overlap[s] = r.overlap;
+  }
   bool live(int s) const { return state[s] != SlotState::kFree; }
   /// IDs handed out so far (removed particles included).
   int size() const { return static_cast<int>(ids_.size()); }

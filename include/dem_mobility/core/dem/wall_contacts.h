@@ -92,8 +92,8 @@ class WallContacts {
   /// Each live slot's candidate triangles at the present positions; `particle_displacement`: the
   /// largest distance of a particle from its x_built now (0 right after a neighbour build).
   void Build(const ParticleStore& ps, int threads, double particle_displacement);
-  /// Adds the wall contacts' forces to the store's particles (and their maxima); sets the walls'
-  /// wrenches. Returns the walls' power on the particles.
+  /// Adds the wall contacts' forces (and maxima) to the particles' sums (ps->sums, packed by the
+  /// force evaluation); sets the walls' wrenches. Returns the walls' power on the particles.
   double Compute(ParticleStore* ps, double dt, int threads);
 
   /// The largest distance of a vertex of the fast (or the slow) walls from where it was at the
