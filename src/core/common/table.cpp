@@ -21,9 +21,7 @@ Table1D::Table1D(std::vector<double> x, std::vector<double> y, const std::string
   }
 }
 
-double Table1D::operator()(double x) const {
-  if (x <= x_.front()) return y_.front();
-  if (x >= x_.back()) return y_.back();
+double Table1D::Between(double x) const {
   // x_[i-1] < x < x_[i] (the first point above x: a scan, as fast as a bisection on the few
   // points of the soil's and the engine's curves, which the DEM step looks up per particle)
   size_t i = 1;

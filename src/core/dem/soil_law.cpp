@@ -39,28 +39,11 @@ SoilParams SoilParams::Read(const YamlReader& y) {
   return p;
 }
 
-double SoilParams::Area() const { return 0.25 * M_PI * diameter * diameter; }
 double SoilParams::Mass() const { return density * M_PI * diameter * diameter * diameter / 6.0; }
 
 double MaxAdhesionForce(const SoilParams& p, double delta_p) {
   if (!p.cohesion) return 0.0;
   return p.cohesion_factor * p.adhesion_stress_vs_plastic_strain(delta_p / p.diameter) * p.Area();
-}
-
-double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double max_tension,
-                                double dt) {
-  if (!p.plasticity) return delta_p;
-  const double target = p.plastic_strain_vs_stress(max_repulsion / p.Area()) * p.diameter;
-  if (target > delta_p) return target;  // loading beyond the history: the deformation grows (fig. 8)
-  // eq. 16 relaxes the deformation at V_relax "due to tension and/or removal of the compression":
-  // while the particle's largest compressive force is below the largest tensile (adhesive) force
-  // it carries, both taken over its contacts now (the paper's "maximum force value over all adjacent
-  // particles"), or while nothing compresses it (why this reading: docs/soil-model.md, "Reading of eq. 16").
-  // Floored at what fig. 8 gives for the present load: only the part left from earlier, higher
-  // loads relaxes, so the next step does not grow it back by V_relax dt (a force jump of
-  // k_n V_relax dt on a lightly loaded particle).
-  if (max_repulsion < max_tension || max_repulsion <= 0.0) return std::max(target, delta_p - p.relax_speed * dt);
-  return delta_p;
 }
 
 }  // namespace dem_mobility::core

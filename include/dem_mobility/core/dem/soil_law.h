@@ -43,7 +43,7 @@ struct SoilParams {
   static SoilParams Read(const YamlReader& y);
 
   // derived
-  double Area() const;          ///< pi d^2 / 4: the area stresses refer to
+  double Area() const { return 0.25 * M_PI * diameter * diameter; }  ///< pi d^2 / 4: the area stresses refer to
   double Mass() const;          ///< rho pi d^3 / 6
   double NormalStiffness() const { return stiffness_stress * Area() / diameter; }  ///< k_n [N/m]
   double NormalDamping() const { return damping_area * Area(); }                    ///< c_n [N s/m]
@@ -123,7 +123,21 @@ double MaxAdhesionForce(const SoilParams& p, double delta_p);
 /// while that force is below the largest adhesive (tensile) force `max_tension` its contacts carry
 /// now, or while it has no compression at all; floored at zero and at fig. 8's value for the present
 /// load (see soil_law.cpp). Unchanged when plasticity is off.
-double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double max_tension,
-                                double dt);
+inline double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double max_tension,
+                                       double dt) {
+  // (inline: the DEM step calls it for every particle)
+  if (!p.plasticity) return delta_p;
+  const double target = p.plastic_strain_vs_stress(max_repulsion / p.Area()) * p.diameter;
+  if (target > delta_p) return target;  // loading beyond the history: the deformation grows (fig. 8)
+  // eq. 16 relaxes the deformation at V_relax "due to tension and/or removal of the compression":
+  // while the particle's largest compressive force is below the largest tensile (adhesive) force
+  // it carries, both taken over its contacts now (the paper's "maximum force value over all adjacent
+  // particles"), or while nothing compresses it (why this reading: docs/soil-model.md, "Reading of eq. 16").
+  // Floored at what fig. 8 gives for the present load: only the part left from earlier, higher
+  // loads relaxes, so the next step does not grow it back by V_relax dt (a force jump of
+  // k_n V_relax dt on a lightly loaded particle).
+  if (max_repulsion < max_tension || max_repulsion <= 0.0) return std::max(target, delta_p - p.relax_speed * dt);
+  return delta_p;
+}
 
 }  // namespace dem_mobility::core
