@@ -114,16 +114,22 @@ void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
   // each slot's partners within the cutoff in the pairs it owns (half list), ascending. Each thread
   // takes a contiguous range of slots and lists their partners one after the other in a buffer of
   // its own (kept from build to build: no allocation per slot), then, once every slot's count is
-  // known, copies them to their place: the same lists for any thread count
+  // known, copies them to their place: the same lists for any thread count. The surviving
+  // contacts' histories are first copied out of the old lists (per thread), then every thread
+  // writes its own range of the new ones in place of the old: nothing is filled twice, and nothing
+  // on one thread while the other waits.
+  struct Carried {
+    Vector3d spring;
+    bool touching;
+  };
   const int n = ps.slots();
   const double cut2 = cutoff_ * cutoff_;
   const int live = cell_start_.back();
   const std::vector<Vector3d>& x = ps.x;
   if (static_cast<int>(found_.size()) < threads) found_.resize(threads);
+  std::vector<std::vector<Carried>> carried(threads);
   std::vector<int> begin(n), end(n), cap(n);
-  std::vector<int> nbr;
-  std::vector<TangentialHistory> hist;
-  std::vector<unsigned char> touching;
+  int total = 0;
 #pragma omp parallel num_threads(threads)
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
@@ -139,11 +145,25 @@ void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
       std::sort(out.begin() + static_cast<long>(first), out.end());
       end[i] = static_cast<int>(out.size() - first);  // the count, for now
     }
+    // carry each surviving contact's history over, from whichever side owned it before
+    std::vector<Carried>& mine = carried[t];
+    ReserveOnHugePages(&mine, out.size());  // (see huge_pages.h)
+    size_t m = 0;
+    for (int i = lo; i < hi; ++i)
+      for (int c = 0; c < end[i]; ++c, ++m) {
+        const int j = out[m];
+        if (const TangentialHistory* h = FindHistory(i, j))
+          mine.push_back(Carried{h->spring, true});
+        else if (const TangentialHistory* g = FindHistory(j, i))
+          mine.push_back(Carried{-g->spring, true});
+        else
+          mine.push_back(Carried{Vector3d::Zero(), false});
+      }
 #pragma omp barrier
 #pragma omp single
     {
-      // the lists in slot order, each with room for slack_ more
-      int total = 0;
+      // the lists in slot order, each with room for slack_ more; in the old lists' place (grown
+      // without copying them when they are too small: they are not read any more)
       for (int i = 0; i < n; ++i) {
         const int count = i < live ? end[i] : 0;
         begin[i] = total;
@@ -151,34 +171,37 @@ void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
         cap[i] = i < live ? end[i] + slack_ : end[i];
         total = cap[i];
       }
-      ReserveOnHugePages(&nbr, total);  // (see huge_pages.h)
-      ReserveOnHugePages(&hist, total);
-      ReserveOnHugePages(&touching, total);
-      nbr.assign(total, -1);
-      hist.assign(total, TangentialHistory());
-      touching.assign(total, 0);
-    }
-    // carry each surviving contact's history over, from whichever side owned it before
-    size_t m = 0;
-    for (int i = lo; i < hi; ++i)
-      for (int k = begin[i]; k < end[i]; ++k, ++m) {
-        const int j = out[m];
-        nbr[k] = j;
-        if (const TangentialHistory* h = FindHistory(i, j)) {
-          hist[k] = *h;
-          touching[k] = 1;
-        } else if (const TangentialHistory* g = FindHistory(j, i)) {
-          hist[k].spring = -g->spring;
-          touching[k] = 1;
-        }
+      if (static_cast<size_t>(total) > nbr_.capacity() || static_cast<size_t>(total) > hist_.capacity() ||
+          static_cast<size_t>(total) > touching_.capacity()) {
+        nbr_ = std::vector<int>();
+        hist_ = std::vector<TangentialHistory>();
+        touching_ = std::vector<unsigned char>();
+        ReserveOnHugePages(&nbr_, total);
+        ReserveOnHugePages(&hist_, total);
+        ReserveOnHugePages(&touching_, total);
       }
+      nbr_.resize(total);
+      hist_.resize(total);
+      touching_.resize(total);
+    }
+    // this thread's slots' lists, slack included: [begin[lo], cap[hi - 1])
+    m = 0;
+    for (int i = lo; i < hi; ++i) {
+      for (int k = begin[i]; k < end[i]; ++k, ++m) {
+        nbr_[k] = out[m];
+        hist_[k].spring = mine[m].spring;
+        touching_[k] = mine[m].touching ? 1 : 0;
+      }
+      for (int k = end[i]; k < cap[i]; ++k) {
+        nbr_[k] = -1;
+        hist_[k] = TangentialHistory();
+        touching_[k] = 0;
+      }
+    }
   }
   nbr_begin_.swap(begin);
   nbr_end_.swap(end);
   nbr_cap_.swap(cap);
-  nbr_.swap(nbr);
-  hist_.swap(hist);
-  touching_.swap(touching);
 }
 
 std::vector<int> NeighbourList::Build(ParticleStore* ps, int threads) {
