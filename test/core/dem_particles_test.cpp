@@ -96,6 +96,43 @@ TEST(DemParticles, RemovingTheParticleBelowLetsTheOneAboveFall) {
   EXPECT_THROW(s.RemoveParticle(below), ConfigError);
 }
 
+// Every step's force starts at each particle's weight (the step's final pass starts the next
+// step's sums): a particle added between steps, into a freed slot or appended, falls freely from
+// its first step (two half kicks of its weight: g dt), and a gravity changed between steps acts
+// from the next force evaluation on (the first half kick still has the old weight)
+TEST(DemParticles, AddedParticlesAndAChangedGravityActFromTheNextStep) {
+  const SoilParams p = Nominal();
+  DemSystem s(p, DemSettings());
+  for (int k = 0; k < 3; ++k) s.AddParticle(Vector3d(k, 0, 0));  // far apart: no contacts
+  s.Finalize(1e-5);
+  const double dt = s.dt();
+  for (int i = 0; i < 10; ++i) s.Step();
+  const Vector3d g(0, 0, -9.81);
+  auto falls_freely = [&](int id, const char* what) {
+    EXPECT_NEAR((s.velocity(id) - dt * g).norm(), 0.0, 1e-12 * dt * g.norm()) << what << ": " << s.velocity(id).transpose();
+  };
+  s.RemoveParticle(1);
+  const int reused = s.AddParticle(Vector3d(5, 0, 0));  // the freed slot
+  s.Step();
+  falls_freely(reused, "in a freed slot");
+  EXPECT_EQ(s.contacts(), 0);
+  const int appended = s.AddParticle(Vector3d(7, 0, 0));
+  s.Step();
+  falls_freely(appended, "appended");
+  s.RemoveParticle(0);
+  const int again = s.AddParticle(Vector3d(9, 0, 0));  // the freed slot, one more step on
+  s.Step();
+  falls_freely(again, "in a freed slot after an append");
+  // gravity changed between steps: dv = (g_old + g_new) dt / 2 in the next step
+  const Vector3d g2(1.0, 0, -3.0), v0 = s.velocity(2);
+  s.set_gravity(g2);
+  s.Step();
+  EXPECT_NEAR((s.velocity(2) - v0 - 0.5 * dt * (g + g2)).norm(), 0.0, 1e-12) << s.velocity(2).transpose();
+  const Vector3d v1 = s.velocity(2);
+  s.Step();
+  EXPECT_NEAR((s.velocity(2) - v1 - dt * g2).norm(), 0.0, 1e-12) << s.velocity(2).transpose();
+}
+
 // a moving soil patch in miniature: particles rained into a box and the oldest removed
 DemSystem Stream(int threads, long* adds) {
   const SoilParams p = Nominal();

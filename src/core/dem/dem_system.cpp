@@ -52,6 +52,11 @@ int DemSystem::AddParticle(const Vector3d& x, const Vector3d& v) {
     if (finalized_) lists_.AppendSlot();
   }
   walls_.ClearSlot(p);
+  // its sums start at its weight (a slot appended: the next step sizes and starts them all)
+  if (appended)
+    sums_started_ = false;
+  else if (sums_started_)
+    ps_.StartSums(p, mass_ * gravity_);
   if (!finalized_) {
     rebuild_ = true;
     return id;
@@ -72,6 +77,7 @@ void DemSystem::RemoveParticle(int id) {
     lists_.Remove(ps_, i);
     walls_.ClearSlot(i);
   }
+  if (sums_started_) ps_.StartSums(i, Vector3d::Zero());  // (a free slot's sums are zero)
   ps_.Remove(id);
 }
 
@@ -142,6 +148,7 @@ void DemSystem::set_gravity(const Vector3d& g) {
     for (int i = 0; i < ps_.slots(); ++i)
       if (ps_.live(i)) ledger_.exchanged -= mass_ * (g - gravity_).dot(ps_.x[i]);
   gravity_ = g;
+  sums_started_ = false;  // (they start at the weight)
 }
 
 void DemSystem::Rebuild() {
@@ -149,6 +156,7 @@ void DemSystem::Rebuild() {
   walls_.PermuteSlots(order);
   walls_.Build(ps_, Threads(), 0.0);
   rebuild_ = false;
+  sums_started_ = false;  // (the slots moved)
   ++builds_;
 }
 
@@ -184,12 +192,15 @@ void DemSystem::Step() {
   double max_disp2 = 0.0;
   int tripped = n;  // the lowest slot a watchdog trips on
   // the drift, each slot then packed for the force evaluation (while it is in the cache: one
-  // pass over the particles fewer; a neighbour build below permutes the slots and packs them again)
+  // pass over the particles fewer; a neighbour build below permutes the slots and packs them again).
+  // The sums were started by the last step's final pass unless something changed the slots since
   ps_.SizeScratch();
+  const bool started = sums_started_;
+  sums_started_ = false;
 #pragma omp parallel for schedule(static) num_threads(Threads()) reduction(max : max_disp2) reduction(min : tripped)
   for (int i = 0; i < n; ++i) {
     if (!ps_.live(i)) {
-      ps_.PackFresh(i, Vector3d::Zero());
+      if (!started) ps_.PackFresh(i, Vector3d::Zero());
       continue;
     }
     if (!ps_.held[i]) {
@@ -198,7 +209,10 @@ void DemSystem::Step() {
       max_disp2 = std::max(max_disp2, (x[i] - ps_.x_built[i]).squaredNorm());
     }
     if (StateTrips(ps_, i, dt_, half_skin)) tripped = std::min(tripped, i);
-    ps_.PackFresh(i, weight);
+    if (started)
+      ps_.PackHot(i);
+    else
+      ps_.PackFresh(i, weight);
   }
   time_ += dt_;
   ++step_;
@@ -215,21 +229,25 @@ void DemSystem::Step() {
   SumForces(packed);
   ledger_.wall_work += h * (power_before + ledger_.wall_power);  // trapezoidal
   const double overlap_limit = settings_.max_overlap * soil_.diameter;
-#pragma omp parallel for schedule(static) num_threads(Threads()) reduction(min : tripped)
-  for (int i = 0; i < n; ++i) {
-    ps_.Unpack(i);
-    if (ps_.live(i) && OverlapTrips(ps_, i, overlap_limit)) tripped = std::min(tripped, i);
-  }
-  if (tripped < n) ReportOverlapTrip(ps_, tripped, soil_.diameter, settings_.max_overlap, step_, time_);
   const bool ledger = plastic_ledger_;
   if (ledger && static_cast<int>(plastic_rec_.size()) < n) {
     plastic_rec_.resize(n);
     plastic_de_.resize(n);
   }
+  // one pass: each slot's sums unpacked and started for the next step's force evaluation (the line
+  // is in the cache now: the drift need not fetch it), the overlap watchdog, the second half kick
+  // and the plastic update (a slot's sums and state read once; a trip is reported after the pass,
+  // with the step's state complete)
   int changed = 0;
-#pragma omp parallel for schedule(static) num_threads(Threads()) reduction(+ : changed)
+#pragma omp parallel for schedule(static) num_threads(Threads()) reduction(min : tripped) reduction(+ : changed)
   for (int i = 0; i < n; ++i) {
-    if (!ps_.live(i)) continue;
+    ps_.Unpack(i);
+    if (!ps_.live(i)) {
+      ps_.StartSums(i, Vector3d::Zero());
+      continue;
+    }
+    ps_.StartSums(i, weight);
+    if (OverlapTrips(ps_, i, overlap_limit)) tripped = std::min(tripped, i);
     if (!ps_.held[i]) v[i] += h * inv_m * f[i];
     const double p0 = ps_.plastic[i], a0 = ps_.adhesion_max[i];
     const double dp = UpdatePlasticDeformation(soil_, p0, ps_.max_repulsion[i], ps_.max_tension[i], dt_);
@@ -247,6 +265,8 @@ void DemSystem::Step() {
       r.a1 = ps_.adhesion_max[i];
     }
   }
+  if (tripped < n) ReportOverlapTrip(ps_, tripped, soil_.diameter, settings_.max_overlap, step_, time_);
+  sums_started_ = true;
   if (ledger && changed > 0) PlasticExchange();
 }
 
@@ -353,6 +373,7 @@ void DemSystem::Io(Ar& ar) {
     const size_t n = ps_.x.size();
     if (lists_.list_begin().size() != n) ar.Fail("the neighbour lists do not match the particle slots");
     if (!walls_.Holds(static_cast<int>(n))) ar.Fail("the walls' contacts do not match the particle slots");
+    sums_started_ = false;  // (scratch: the first step starts them)
   }
 }
 template void DemSystem::Io(StateWriter&);

@@ -183,6 +183,10 @@ class DemSystem {
   double dt_ = 0.0, time_ = 0.0;
   long step_ = 0, builds_ = 0, overflow_builds_ = 0;
   bool finalized_ = false, rebuild_ = true;
+  /// ps_.sums hold every slot's start (its weight, or zero when free) for the next force
+  /// evaluation: the last step's final pass started them and nothing has moved a slot or changed
+  /// gravity since (scratch, not in a checkpoint)
+  bool sums_started_ = false;
   ParticleStore ps_;
   NeighbourList lists_;
   WallContacts walls_;

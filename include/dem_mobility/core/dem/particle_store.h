@@ -82,9 +82,8 @@ class ParticleStore {
     hot.resize(n);
     sums.resize(n);
   }
-  /// Packs slot s for a sweep: its hot record from x, v, plastic and adhesion_max, its sums started
-  /// at force `f0` with zero maxima (the force evaluation's start: a live slot's weight, or zero).
-  void PackFresh(int s, const Eigen::Vector3d& f0) {
+  /// Packs slot s's hot record for a sweep, from x, v, plastic and adhesion_max.
+  void PackHot(int s) {
     HotParticle& h = hot[s];
     h.x[0] = x[s].x();
     h.x[1] = x[s].y();
@@ -94,11 +93,20 @@ class ParticleStore {
     h.v[2] = v[s].z();
     h.plastic = plastic[s];
     h.adhesion_max = adhesion_max[s];
+  }
+  /// Starts slot s's sums for a force evaluation: force `f0` (a live slot's weight, or zero), zero
+  /// maxima.
+  void StartSums(int s, const Eigen::Vector3d& f0) {
     PairSums& r = sums[s];
     r.f[0] = f0.x();
     r.f[1] = f0.y();
     r.f[2] = f0.z();
     r.max_repulsion = r.max_tension = r.overlap = 0.0;
+  }
+  /// Packs slot s for a sweep: its hot record and its sums started at `f0`.
+  void PackFresh(int s, const Eigen::Vector3d& f0) {
+    PackHot(s);
+    StartSums(s, f0);
   }
   /// Slot s's sums back into f, max_repulsion, max_tension and overlap.
   void Unpack(int s) {
