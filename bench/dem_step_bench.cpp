@@ -90,9 +90,7 @@ double TriadBandwidth(int threads) {
   return best;
 }
 
-// The rates of the default (vector) kernel and of the scalar reference at 1 and 2 threads, the
-// rebuilds in the timed steps and the contacts at the end of the warm-up: the lines of one bed.
-// DM_BENCH_REPEATS (default 3): how many times each rate of the default kernel is timed
+// DM_BENCH_REPEATS (default 3): how many times each rate is timed
 int Repeats() {
   const char* e = std::getenv("DM_BENCH_REPEATS");
   if (!e) return 3;
@@ -105,6 +103,20 @@ int Repeats() {
   return static_cast<int>(r);
 }
 
+// The rates of `kernel` at 1 and 2 threads, alternated, the best of `repeats` timings each (this
+// VM's rates move by up to a third between runs minutes apart: the best is the least disturbed;
+// bench.sh times LAMMPS the same way)
+void BestRates(const DemSystem& s, int steps, int repeats, PairKernel kernel, Timed* r1, Timed* r2) {
+  *r1 = *r2 = Timed{};
+  for (int r = 0; r < repeats; ++r) {
+    const Timed a = Rate(s, 1, steps, kernel), b = Rate(s, 2, steps, kernel);
+    if (a.rate > r1->rate) *r1 = a;
+    if (b.rate > r2->rate) *r2 = b;
+  }
+}
+
+// The rates of the default (vector) kernel and of the scalar reference at 1 and 2 threads, the
+// rebuilds in the timed steps and the contacts at the end of the warm-up: the lines of one bed.
 void Report(const char* bed, const DemSystem& s, int steps) {
   const int repeats = Repeats();
   DemSystem warm = s;
@@ -117,24 +129,12 @@ void Report(const char* bed, const DemSystem& s, int steps) {
   std::printf("dem_step %s_mean_repulsion %.4g N\n", bed, c.mean_repulsion);
   std::printf("dem_step %s_adhesive_contact_fraction %.3f ratio\n", bed, c.adhesive_fraction);
   std::fflush(stdout);
-  // 1 and 2 threads alternated, best of `repeats` each (this VM's rates move by up to a third
-  // between runs minutes apart: the best of each is the least disturbed; bench.sh times LAMMPS
-  // the same way)
-  Timed v1{0.0, 0}, v2{0.0, 0};
-  for (int r = 0; r < repeats; ++r) {
-    const Timed a = Rate(s, 1, steps), b = Rate(s, 2, steps);
-    if (a.rate > v1.rate) v1 = a;
-    if (b.rate > v2.rate) v2 = b;
-  }
+  Timed v1, v2, s1, s2;
+  BestRates(s, steps, repeats, PairKernel::kAuto, &v1, &v2);
   // DM_DEM_BENCH_VECTOR_ONLY=1: the default kernel alone (for a profile of it)
   const char* only = std::getenv("DM_DEM_BENCH_VECTOR_ONLY");
   const bool scalar = !(only && std::string(only) == "1");
-  Timed s1{0.0, 0}, s2{0.0, 0};
-  for (int r = 0; scalar && r < repeats; ++r) {
-    const Timed a = Rate(s, 1, steps, PairKernel::kScalar), b = Rate(s, 2, steps, PairKernel::kScalar);
-    if (a.rate > s1.rate) s1 = a;
-    if (b.rate > s2.rate) s2 = b;
-  }
+  if (scalar) BestRates(s, steps, repeats, PairKernel::kScalar, &s1, &s2);
   std::printf("# dem_step %s_rate: the best of %d timings at each thread count, alternated (the scalar kernel's too)\n", bed, repeats);
   std::printf("dem_step %s_rate_1thread %.3f Mparticle-steps/s\n", bed, v1.rate * 1e-6);
   std::printf("dem_step %s_rate_2threads %.3f Mparticle-steps/s\n", bed, v2.rate * 1e-6);

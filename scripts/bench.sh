@@ -83,6 +83,9 @@ if [ "$want" = all ] || [ "$want" = road_scene ]; then
 fi
 
 if [ "$want" = all ] || [ "$want" = dem_step ]; then
+  case "${DM_BENCH_REPEATS:-3}" in
+    ''|*[!0-9]*|0) echo "DM_BENCH_REPEATS=${DM_BENCH_REPEATS} must be a whole number from 1 to 100" >&2; exit 2 ;;
+  esac
   "$DM_BUILD/core/bench/dem_step_bench" "$DM_ROOT/config/soils/nominal_clay.yaml" 1000 | tee "$tmp/dem.txt"
   # the same bed in LAMMPS (Debian's package), 1 rank and 2 MPI ranks, timed 1000 steps
   ensure_packages "${DM_BENCH_PACKAGES[@]}" >/dev/null
@@ -96,7 +99,13 @@ if [ "$want" = all ] || [ "$want" = dem_step ]; then
     # (the logs kept are the best runs')
     rate() { awk '/Loop time of .* for 1000 steps/ {printf "%.3f", $(NF-1) * 1000 / $4 / 1e6}' "$1"; }
     # best LOG NEW: keeps NEW as LOG when its rate is higher (or LOG is missing)
-    best() { if [ ! -f "$1" ] || python3 -c "import sys; sys.exit(0 if float('$(rate "$2")' or 0) > float('$(rate "$1")' or 0) else 1)"; then mv "$2" "$1"; else rm -f "$2"; fi; }
+    best() {
+      if [ ! -f "$1" ] || awk -v new="$(rate "$2")" -v old="$(rate "$1")" 'BEGIN { exit !(new + 0 > old + 0) }'; then
+        mv "$2" "$1"
+      else
+        rm -f "$2"
+      fi
+    }
     rm -f "$tmp/lmp1.log" "$tmp/lmp2.log" "$tmp/lmp3.log"
     for _ in $(seq "${DM_BENCH_REPEATS:-3}"); do
       (cd "$tmp" && lmp -in bed.in >lmp1.try 2>&1 && mpirun --allow-run-as-root --oversubscribe -np 2 lmp -in bed.in >lmp2.try 2>&1)
