@@ -1,8 +1,10 @@
 // The pair kernels: the vector kernel (each instance this CPU can run) gives the scalar reference's
 // forces, maxima, overlaps and contact histories bit for bit, on random pairs that reach every
-// branch of the law, and a DEM run on it gives the scalar run's states bit for bit.
+// branch of the law, and a DEM run on it gives the scalar run's states bit for bit; the plastic
+// ledger's vector pass gives the scalar pass's energies bit for bit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -66,15 +68,10 @@ void ExpectSameBits(const SweepOut& a, const SweepOut& b, const char* what) {
   EXPECT_EQ(bad, 0) << what << ": slots or contacts that differ from the scalar kernel";
 }
 
-// Random pairs of particles (each pair far from the others, so each branch of the law is met in
-// isolation), then a dense random cluster with a wide list cutoff (half lists of 30-50 partners:
-// several blocks per particle); random overlaps, velocities, plastic deformations, adhesions and
-// anchor springs. The branches are counted with the scalar law itself.
-TEST(PairKernel, VectorGivesTheScalarKernelsResultsBitForBitOnEveryBranch) {
-  SoilParams soil = Nominal();
-  const SoilContactLaw law(soil);
-  const double D = soil.diameter, d0 = law.d0, dt = 2e-5;
-  std::mt19937_64 rng(12345);
+// 4000 random pairs of particles (each pair far from the others, so each branch of the law is met
+// in isolation; separations from a gap of 0.05 d to an overlap of 0.25 d: adhesion, repulsion, the
+// skin), then a dense random cluster of 500 (overlaps up to 0.3 d); random velocities.
+ParticleStore PairsAndACluster(double D, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0), u01(0.0, 1.0);
   auto random_unit = [&] {
     Vector3d n;
@@ -88,18 +85,29 @@ TEST(PairKernel, VectorGivesTheScalarKernelsResultsBitForBitOnEveryBranch) {
   for (int p = 0; p < pairs; ++p) {
     const Vector3d c(3.0 * D * (p % 20), 3.0 * D * ((p / 20) % 20), 3.0 * D * (p / 400));
     const Vector3d n = random_unit();
-    // separations from a gap of 0.05 d to an overlap of 0.25 d (adhesion, repulsion, the skin)
     const double overlap = D * (-0.05 + 0.3 * u01(rng));
     const double dist = D - overlap;
     const Vector3d v = 0.3 * Vector3d(u(rng), u(rng), u(rng));
     ps.Add(c + 0.5 * dist * n, v, Vector3d::Zero(), 0.0, SlotState::kListed, &appended);
     ps.Add(c - 0.5 * dist * n, -v, Vector3d::Zero(), 0.0, SlotState::kListed, &appended);
   }
-  // the cluster: 500 particles in a cube, overlaps up to 0.3 d
   const Vector3d corner(0.0, 0.0, 30.0 * D);
   for (int i = 0; i < 500; ++i)
     ps.Add(corner + 4.0 * D * Vector3d(u01(rng), u01(rng), u01(rng)), 0.5 * Vector3d(u(rng), u(rng), u(rng)),
            Vector3d::Zero(), 0.0, SlotState::kListed, &appended);
+  return ps;
+}
+
+// Random pairs of particles and a cluster (PairsAndACluster) with a wide list cutoff (half lists
+// of 30-50 partners: several blocks per particle); random overlaps, velocities, plastic deformations, adhesions and
+// anchor springs. The branches are counted with the scalar law itself.
+TEST(PairKernel, VectorGivesTheScalarKernelsResultsBitForBitOnEveryBranch) {
+  SoilParams soil = Nominal();
+  const SoilContactLaw law(soil);
+  const double D = soil.diameter, d0 = law.d0, dt = 2e-5;
+  std::mt19937_64 rng(12345);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), u01(0.0, 1.0);
+  ParticleStore ps = PairsAndACluster(D, rng);
   NeighbourList lists(2.0 * D, 2);
   lists.Build(&ps, 1);
   for (int i = 0; i < ps.slots(); ++i) {
@@ -169,8 +177,78 @@ TEST(PairKernel, VectorGivesTheScalarKernelsResultsBitForBitOnEveryBranch) {
   for (PairKernel kernel : VectorKernels()) ExpectSameBits(ref_plain, Sweep(plain, D, dt, 2, ps, lists, kernel), "no cohesion");
 }
 
-// A poured cohesive bed stepped on the scalar and on each vector kernel: the same states to the bit
-// after 300 steps (contacts made and broken, plasticity, walls).
+// The plastic ledger's pass (PlasticExchangeEnergies) on the pairs and the cluster: each slot's
+// deformation and adhesion changed (loading and relaxing) or not, a free slot among them. Every
+// vector instance gives the scalar reference's per-slot sums bit for bit, for 1 and 2 threads,
+// with and without cohesion. The branches are counted with NormalEnergy itself.
+TEST(PairKernel, ThePlasticLedgersVectorPassGivesTheScalarSumsBitForBit) {
+  SoilParams soil = Nominal();
+  const SoilContactLaw law(soil);
+  const double D = soil.diameter;
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  ParticleStore ps = PairsAndACluster(D, rng);
+  NeighbourList lists(2.0 * D, 2);
+  lists.Build(&ps, 1);
+  std::vector<PlasticChange> rec(ps.slots());
+  for (int i = 0; i < ps.slots(); ++i) {
+    PlasticChange& r = rec[i];
+    r.x = ps.x[i];
+    r.p0 = u01(rng) < 0.2 ? 0.0 : 0.06 * D * u01(rng);
+    r.a0 = u01(rng) < 0.1 ? 0.0 : MaxAdhesionForce(soil, r.p0);
+    const double c = u01(rng);  // unchanged, loaded (more deformation) or relaxed (less)
+    r.p1 = c < 0.3 ? r.p0 : std::max(0.0, r.p0 + 0.02 * D * (c < 0.65 ? u01(rng) : -u01(rng)));
+    r.a1 = r.p1 == r.p0 ? r.a0 : MaxAdhesionForce(soil, r.p1);
+  }
+  ps.state[17] = SlotState::kFree;
+  int unchanged = 0, out_of_reach = 0, adhesion = 0, repulsion = 0, rising = 0, falling = 0, longest = 0;
+  for (int i = 0; i < ps.slots(); ++i) {
+    longest = std::max(longest, lists.end(i) - lists.begin(i));
+    for (int k = lists.begin(i); k < lists.end(i); ++k) {
+      const PlasticChange &ri = rec[i], &rj = rec[lists.partners()[k]];
+      unchanged += ri.p1 == ri.p0 && rj.p1 == rj.p0;
+      const double gap = D - (ri.x - rj.x).norm();
+      for (double p : {ri.p0 + rj.p0, ri.p1 + rj.p1}) {
+        const double d = gap - p;
+        if (!(d > 0.0)) {
+          ++out_of_reach;
+          continue;
+        }
+        (d < law.d0 ? adhesion : repulsion) += 1;
+        if (d < law.d0) (d <= law.dp ? rising : falling) += 1;
+      }
+    }
+  }
+  std::printf("ledger branches: unchanged pairs %d, out of reach %d, adhesion %d (rising %d, falling %d), "
+              "repulsion %d; longest half list %d\n", unchanged, out_of_reach, adhesion, rising, falling, repulsion, longest);
+  for (int c : {unchanged, out_of_reach, rising, falling, repulsion}) EXPECT_GT(c, 50);
+  EXPECT_GT(longest, 2 * 32) << "some particle's half list spans several blocks";
+  auto run = [&](const SoilContactLaw& l, int threads, PairKernel kernel) {
+    std::vector<double> de(ps.slots(), -1.0);
+    PlasticExchangeEnergies(l, D, threads, ps, lists, rec.data(), de.data(), kernel);
+    return de;
+  };
+  for (bool cohesion : {true, false}) {
+    soil.cohesion = cohesion;
+    const SoilContactLaw l(soil);
+    const std::vector<double> ref = run(l, 1, PairKernel::kScalar);
+    EXPECT_EQ(ref[17], 0.0);
+    int moved = 0;
+    for (double e : ref) moved += e != 0.0;
+    EXPECT_GT(moved, ps.slots() / 4) << "slots whose pairs moved energy";
+    for (PairKernel kernel : VectorKernels())
+      for (int threads : {1, 2}) {
+        const std::vector<double> de = run(l, threads, kernel);
+        int bad = 0;
+        for (int i = 0; i < ps.slots(); ++i) bad += !SameBits(ref[i], de[i]);
+        EXPECT_EQ(bad, 0) << PairKernelName(kernel) << ", " << threads << " threads, cohesion " << cohesion
+                          << ": slots whose sum differs from the scalar pass";
+      }
+  }
+}
+
+// A poured cohesive bed stepped on the scalar and on each vector kernel: the same states and the
+// same plastic ledger to the bit after 300 steps (contacts made and broken, plasticity, walls).
 TEST(PairKernel, ADemRunOnTheVectorKernelIsTheScalarRunBitForBit) {
   const SoilParams soil = Nominal();
   const double D = soil.diameter;
@@ -188,11 +266,13 @@ TEST(PairKernel, ADemRunOnTheVectorKernelIsTheScalarRunBitForBit) {
           s.AddParticle(Vector3d((i + 0.7 + 0.1 * u(rng)) * D, (j + 0.7 + 0.1 * u(rng)) * D, (k + 0.6) * 0.93 * D),
                         Vector3d(0.1 * (u(rng) - 0.5), 0.1 * (u(rng) - 0.5), -0.3));
     s.Finalize(0.5 * s.CriticalTimeStep().dt_crit);
+    s.set_plastic_ledger(true);
     for (int i = 0; i < 300; ++i) s.Step();
     return s;
   };
   const DemSystem ref = run(PairKernel::kScalar);
   EXPECT_GT(ref.contacts(), 1000);
+  EXPECT_NE(ref.plastic_exchange(), 0.0);
   for (PairKernel kernel : VectorKernels()) {
     const DemSystem s = run(kernel);
     EXPECT_EQ(s.pair_kernel(), kernel);
@@ -201,6 +281,7 @@ TEST(PairKernel, ADemRunOnTheVectorKernelIsTheScalarRunBitForBit) {
       bad += !SameBits(ref.position(id), s.position(id)) || !SameBits(ref.velocity(id), s.velocity(id)) ||
              !SameBits(ref.plastic_deformation(id), s.plastic_deformation(id));
     EXPECT_EQ(bad, 0) << PairKernelName(kernel) << ": particles whose state differs from the scalar run";
+    EXPECT_TRUE(SameBits(ref.plastic_exchange(), s.plastic_exchange())) << PairKernelName(kernel) << ": the plastic ledger";
   }
 }
 

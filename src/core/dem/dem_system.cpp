@@ -257,7 +257,7 @@ void DemSystem::Step() {
       ++changed;
     }
     if (ledger) {
-      PlasticRecord& r = plastic_rec_[i];
+      PlasticChange& r = plastic_rec_[i];
       r.x = x[i];
       r.p0 = p0;
       r.a0 = a0;
@@ -272,35 +272,12 @@ void DemSystem::Step() {
 
 void DemSystem::PlasticExchange() {
   // the energy the changed deformations (and adhesions) moved, at the positions they changed at:
-  // every listed pair with a changed end, its normal energy after less before; per slot in
-  // parallel, summed in slot order (the same sum on any number of threads). A slot's record holds
-  // what the pass reads of it (the step's plastic update wrote it): one cache line per partner
+  // every listed pair with a changed end, its normal energy after less before (per slot, on the
+  // pair kernel's instance; the records the step's plastic update wrote), summed in slot order
+  // (the same sum on any number of threads)
   const int n = ps_.slots();
-  const double D = soil_.diameter;
-  const PlasticRecord* rec = plastic_rec_.data();
-  const int* partners = lists_.partners().data();
-#pragma omp parallel for schedule(static) num_threads(Threads())
-  for (int i = 0; i < n; ++i) {
-    double de = 0.0;
-    if (ps_.live(i)) {
-      const PlasticRecord& ri = rec[i];
-      const bool ci = ri.p1 != ri.p0;
-      const int end = lists_.end(i);
-      for (int k = lists_.begin(i); k < end; ++k) {
-        const PlasticRecord& rj = rec[partners[k]];
-        if (!ci && rj.p1 == rj.p0) continue;
-        const double p1 = ri.p1 + rj.p1, p0 = ri.p0 + rj.p0;
-        // out of reach before and after the change (no overlap either way): nothing moved, and
-        // no square root taken
-        const double reach = D - std::min(p1, p0);
-        const double r2 = (ri.x - rj.x).squaredNorm();
-        if (!(reach > 0.0) || r2 >= reach * reach) continue;
-        const double gap = D - std::sqrt(r2);
-        de += NormalEnergy(law_, gap - p1, std::min(ri.a1, rj.a1)) - NormalEnergy(law_, gap - p0, std::min(ri.a0, rj.a0));
-      }
-    }
-    plastic_de_[i] = de;
-  }
+  PlasticExchangeEnergies(law_, soil_.diameter, Threads(), ps_, lists_, plastic_rec_.data(), plastic_de_.data(),
+                          settings_.pair_kernel);
   double sum = 0.0;
   for (int i = 0; i < n; ++i) sum += plastic_de_[i];
   ledger_.plastic += sum;
@@ -352,7 +329,7 @@ DemContactSummary DemSystem::ContactSummary() const {
 
 size_t DemSystem::MemoryBytes() const {
   return ps_.MemoryBytes() + lists_.MemoryBytes() + walls_.MemoryBytes() +
-         plastic_rec_.capacity() * sizeof(PlasticRecord) + plastic_de_.capacity() * sizeof(double);
+         plastic_rec_.capacity() * sizeof(PlasticChange) + plastic_de_.capacity() * sizeof(double);
 }
 
 Vector3d DemSystem::Momentum() const {

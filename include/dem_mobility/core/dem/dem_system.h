@@ -192,17 +192,11 @@ class DemSystem {
   WallContacts walls_;
   DemLedger ledger_;
   bool plastic_ledger_ = false;
-  /// What the plastic pass reads of a slot, packed into one cache line by the step's plastic
-  /// update: its position and its deformation and adhesion before and after the step's change
-  /// (one line per partner instead of one in each of six arrays).
-  struct alignas(64) PlasticRecord {
-    Eigen::Vector3d x;
-    double p0, a0, p1, a1;
-  };
-  static_assert(sizeof(PlasticRecord) == 64, "one cache line");
   // the plastic pass's scratch, written and read within a step (not state: not in a checkpoint),
-  // grown with the slots: each slot's record and the energy change of its half list's pairs
-  std::vector<PlasticRecord, Eigen::aligned_allocator<PlasticRecord>> plastic_rec_;
+  // grown with the slots: each slot's record (pair_sweep.h's PlasticChange: what the pass reads of
+  // it, packed into one cache line by the step's plastic update) and the energy change of its half
+  // list's pairs
+  std::vector<PlasticChange, Eigen::aligned_allocator<PlasticChange>> plastic_rec_;
   std::vector<double> plastic_de_;
 };
 

@@ -49,6 +49,24 @@ void SweepPacked(const SoilContactLaw& law, double diameter, double dt, int thre
 void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
                 NeighbourList* lists, PairKernel kernel = PairKernel::kAuto);
 
+/// A slot's part in the plastic ledger's pass (DemSystem::set_plastic_ledger): its position, and
+/// its plastic deformation and largest adhesion before (p0, a0) and after (p1, a1) the step's
+/// plastic update. One cache line: a partner's record is read once per pair.
+struct alignas(64) PlasticChange {
+  Eigen::Vector3d x;
+  double p0, a0, p1, a1;
+};
+static_assert(sizeof(PlasticChange) == 64, "one cache line");
+
+/// The energy the step's plastic changes moved at fixed positions, per slot: de[i] is the sum over
+/// slot i's listed pairs, in list order, of the pair's normal energy (NormalEnergy) after the change
+/// less before (0 for a free slot and for a pair out of reach both before and after). The vector
+/// instances run the pairs of consecutive slots in blocks, as the sweep does, and give the scalar
+/// reference's sums bit for bit; each slot's sum is its own, so any number of threads gives them too.
+void PlasticExchangeEnergies(const SoilContactLaw& law, double diameter, int threads, const ParticleStore& ps,
+                             const NeighbourList& lists, const PlasticChange* rec, double* de,
+                             PairKernel kernel = PairKernel::kAuto);
+
 /// The benchmark's ceiling: pairs per second of the law alone on `kernel` (vector instances only),
 /// on one block of 32 pairs in contact that stays in L1 (no gather, no scatter, no memory), over
 /// `repetitions` evaluations on one thread.
