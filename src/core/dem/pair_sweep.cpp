@@ -595,6 +595,18 @@ void LedgerRangeBaseline(const LedgerConstants& c, bool adhesion, const SlotStat
   LedgerRangeBody(c, adhesion, state, nbr_begin, nbr_end, nbr, rec, begin, end, de);
 }
 
+// Of the three compiled instances of a vector function, the one `kernel` names (kAuto resolved for
+// this CPU; a kernel named outright taken as it is); nullptr for the scalar reference.
+template <class F>
+F InstanceOf(PairKernel kernel, F avx512, F avx2, F baseline) {
+  switch (kernel == PairKernel::kAuto ? ResolvePairKernel(kernel) : kernel) {
+    case PairKernel::kVectorAvx512: return avx512;
+    case PairKernel::kVectorAvx2: return avx2;
+    case PairKernel::kVectorBaseline: return baseline;
+    default: return nullptr;
+  }
+}
+
 }  // namespace
 
 PairKernel ResolvePairKernel(PairKernel requested) {
@@ -627,12 +639,9 @@ const char* PairKernelName(PairKernel kernel) {
 void SweepPacked(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
                  NeighbourList* lists, PairKernel kernel) {
   DM_DEMAND(static_cast<int>(ps->hot.size()) == ps->slots() && static_cast<int>(ps->sums.size()) == ps->slots());
-  switch (kernel == PairKernel::kAuto ? ResolvePairKernel(kernel) : kernel) {
-    case PairKernel::kVectorAvx512: return SweepVector(SweepSlabAvx512, law, diameter, dt, threads, ps, lists);
-    case PairKernel::kVectorAvx2: return SweepVector(SweepSlabAvx2, law, diameter, dt, threads, ps, lists);
-    case PairKernel::kVectorBaseline: return SweepVector(SweepSlabBaseline, law, diameter, dt, threads, ps, lists);
-    default: return SweepScalar(law, diameter, dt, threads, ps, lists);
-  }
+  if (const SlabFunction slab = InstanceOf<SlabFunction>(kernel, SweepSlabAvx512, SweepSlabAvx2, SweepSlabBaseline))
+    return SweepVector(slab, law, diameter, dt, threads, ps, lists);
+  SweepScalar(law, diameter, dt, threads, ps, lists);
 }
 
 void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
@@ -654,13 +663,8 @@ void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threa
 
 void PlasticExchangeEnergies(const SoilContactLaw& law, double diameter, int threads, const ParticleStore& ps,
                              const NeighbourList& lists, const PlasticChange* rec, double* de, PairKernel kernel) {
-  LedgerFunction range = nullptr;
-  switch (kernel == PairKernel::kAuto ? ResolvePairKernel(kernel) : kernel) {
-    case PairKernel::kVectorAvx512: range = LedgerRangeAvx512; break;
-    case PairKernel::kVectorAvx2: range = LedgerRangeAvx2; break;
-    case PairKernel::kVectorBaseline: range = LedgerRangeBaseline; break;
-    default: return PlasticExchangeScalar(law, diameter, threads, ps, lists, rec, de);
-  }
+  const LedgerFunction range = InstanceOf<LedgerFunction>(kernel, LedgerRangeAvx512, LedgerRangeAvx2, LedgerRangeBaseline);
+  if (!range) return PlasticExchangeScalar(law, diameter, threads, ps, lists, rec, de);
   const LedgerConstants c{diameter, law.k_n, law.d0, law.dp};
   const bool adhesion = law.cohesion && law.dp > 0.0;
   const int n = ps.slots();
@@ -688,13 +692,10 @@ double PairLawThroughput(PairKernel kernel, const SoilContactLaw& law, double di
     b.amax[l] = 1.0;
     b.sx[l] = b.sy[l] = b.sz[l] = 0.0;
   }
-  void (*run)(const LawConstants&, Block*, long) = nullptr;
-  switch (ResolvePairKernel(kernel)) {
-    case PairKernel::kVectorAvx512: run = LawOnlyAvx512; break;
-    case PairKernel::kVectorAvx2: run = LawOnlyAvx2; break;
-    case PairKernel::kVectorBaseline: run = LawOnlyBaseline; break;
-    default: throw ConfigError("PairLawThroughput: the scalar kernel has no block law");
-  }
+  using LawOnly = void (*)(const LawConstants&, Block*, long);
+  // (resolved first: a vector instance this CPU lacks is refused)
+  const LawOnly run = InstanceOf<LawOnly>(ResolvePairKernel(kernel), LawOnlyAvx512, LawOnlyAvx2, LawOnlyBaseline);
+  if (!run) throw ConfigError("PairLawThroughput: the scalar kernel has no block law");
   const auto t0 = std::chrono::steady_clock::now();
   run(c, &b, repetitions);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
