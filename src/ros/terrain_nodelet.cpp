@@ -5,7 +5,9 @@
 // (the DEM soil) is prepared on a thread of its own (the manager keeps loading the other nodelets;
 // the vehicle waits for the first answer) and shows its particles and tools (the moving patch's
 // leveling cylinder and plate, bounding sphere, box and emitter zone) every 1 / cloud_rate of
-// simulated time. The service terrain/report gives the terrain's own figures for the run's result.
+// simulated time. The service terrain/report gives the terrain's own figures for the run's result
+// (and, within the manager's process, TerrainFiguresBoard: when ROS is shutting down, and once this
+// nodelet has unloaded, its last figures).
 // No physics here: the core computes, the nodelet converts.
 
 #include <atomic>
@@ -29,6 +31,7 @@
 #include "dem_mobility/ros/conversions.h"
 #include "dem_mobility/ros/core_names.h"
 #include "dem_mobility/ros/dem_visuals.h"
+#include "dem_mobility/ros/terrain_figures_board.h"
 
 namespace dem_mobility {
 
@@ -38,6 +41,9 @@ class TerrainNodelet : public nodelet::Nodelet {
     stop_prepare_ = true;  // a preparation in progress stops within a step
     if (prepare_.joinable()) prepare_.join();
     responder_.reset();  // the vehicle learns at once that its terrain is gone
+    // the figures of the last exchange answered, for a vehicle writing its result after this (Ctrl-C:
+    // roslaunch unloads the nodelets while the vehicle finishes)
+    if (!report_name_.empty()) TerrainFiguresBoard::Close(report_name_);
     if (served_ > 0) NODELET_INFO("terrain: %lu exchanges answered", static_cast<unsigned long>(served_));
   }
 
@@ -62,6 +68,8 @@ class TerrainNodelet : public nodelet::Nodelet {
     cloud_ = nh.advertise<sensor_msgs::PointCloud2>("terrain/particles", 2);
     tools_ = nh.advertise<visualization_msgs::MarkerArray>("terrain/tools", 2);
     report_ = nh.advertiseService("terrain/report", &TerrainNodelet::Report, this);
+    report_name_ = report_.getService();
+    TerrainFiguresBoard::Open(report_name_, [this]() { return Figures(); });
     // a DEM soil takes minutes to prepare: not in the manager's loading thread
     prepare_ = std::thread([this, scene, transport, timing, nh]() mutable { Prepare(nh, scene, transport, timing); });
   }
@@ -155,13 +163,20 @@ class TerrainNodelet : public nodelet::Nodelet {
   }
 
   bool Report(TerrainReport::Request&, TerrainReport::Response& res) {
+    res = Figures();
+    return true;
+  }
+
+  /// The terrain's own figures now (the service's answer).
+  TerrainReport::Response Figures() {
+    TerrainReport::Response res;
     std::lock_guard<std::mutex> lock(mutex_);
     res.time = time_;
     res.served = served_;
     if (!model_) {
       res.error = error_.empty() ? "the terrain is not prepared yet" : "the terrain could not start: " + error_;
       res.figures = "{}";
-      return true;
+      return res;
     }
     res.model = model_->description().model;
     ResultFile f("", "");
@@ -178,7 +193,7 @@ class TerrainNodelet : public nodelet::Nodelet {
     }
     e << YAML::EndMap;
     res.figures = e.c_str();
-    return true;
+    return res;
   }
 
   // --- display
@@ -317,6 +332,7 @@ class TerrainNodelet : public nodelet::Nodelet {
   std::unique_ptr<TerrainModel> model_;
   std::string error_;
   std::unique_ptr<ExchangeResponder<WheelStates, WheelWrenches>> responder_;
+  std::string report_name_;  ///< the report service's name (its entry on TerrainFiguresBoard)
   std::shared_ptr<Channel<WheelStates, WheelWrenches>> failed_;  ///< held closed when the setup failed
   std::atomic<bool> stop_prepare_{false};
   std::thread prepare_;

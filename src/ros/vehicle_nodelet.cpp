@@ -3,7 +3,8 @@
 // and publishes what users watch and keep: /clock, tf (every body), odometry, the exchanged wheel
 // states, wrenches and driver commands (decimated to log_rate), markers, progress, the result. The
 // result YAML holds the terrain's own figures too (a DEM soil's level, table, patch checks): the
-// terrain nodelet gives them through its service terrain/report once the run is over.
+// terrain nodelet gives them through its service terrain/report once the run is over (or, when ROS
+// is shutting down, as on Ctrl-C, directly within the manager's process: TerrainFiguresBoard).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -30,6 +31,7 @@
 #include "dem_mobility/ros/vehicle_visuals.h"
 #include "dem_mobility/ros/core_names.h"
 #include "dem_mobility/ros/recorder_watch.h"
+#include "dem_mobility/ros/terrain_figures_board.h"
 
 namespace dem_mobility {
 namespace {
@@ -400,17 +402,31 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   }
 
   /// The terrain's own figures (a YAML map; empty when it has none or could not give them: then
-  /// `error` says why), from the terrain nodelet's service terrain/report.
+  /// `error` says why), from the terrain nodelet's service terrain/report; when that cannot answer
+  /// (ROS shutting down on Ctrl-C, the terrain unloaded), from the terrain nodelet in this process
+  /// (TerrainFiguresBoard: its figures now, or those of its last exchange once it has unloaded).
   YAML::Node TerrainFigures(std::string* error) {
     ros::ServiceClient client = getNodeHandle().serviceClient<TerrainReport>("terrain/report");
     TerrainReport srv;
+    std::string unanswered;
     // the terrain nodelet advertises it when it loads; one that is gone (unloaded, killed) is not
     // waited for long
-    if (!client.waitForExistence(ros::Duration(2.0))) {
-      *error = "no terrain answers " + client.getService();
-    } else if (!client.call(srv)) {
-      *error = client.getService() + " failed";
-    } else if (!srv.response.error.empty()) {
+    if (!ros::ok())
+      unanswered = "ROS is shutting down";
+    else if (!client.waitForExistence(ros::Duration(2.0)))
+      unanswered = "no terrain answers " + client.getService();
+    else if (!client.call(srv))
+      unanswered = client.getService() + " failed";
+    if (!unanswered.empty()) {
+      if (!TerrainFiguresBoard::Read(client.getService(), &srv.response)) {
+        *error = unanswered;
+        NODELET_WARN("the result goes without the terrain's own figures: %s", error->c_str());
+        return YAML::Node(YAML::NodeType::Map);
+      }
+      NODELET_INFO("the terrain's own figures (t = %.6g s) from the terrain nodelet in this process: %s",
+                   srv.response.time, unanswered.c_str());
+    }
+    if (!srv.response.error.empty()) {
       *error = srv.response.error;
     } else {
       try {
