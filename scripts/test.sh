@@ -53,7 +53,7 @@ say "test: the cone index calibration sweep on tiny cases (roslaunch, bags, tabl
 python3 "$DM_ROOT/test/ros/test_cone_sweep.py"
 say "test: the single-wheel rig through roslaunch (tiny run: bag, result message and YAML; a bad slip)"
 python3 "$DM_ROOT/test/ros/test_single_wheel.py"
-say "test: the vehicle on the DEM soil patch through roslaunch (tiny: result and soil figures as the core runner's, bag, 1 vs 2 soil threads; a bad cone index)"
+say "test: the vehicle on the DEM soil patch through roslaunch (tiny: result and soil figures as the core runner's, bag, 1 vs 2 soil threads; a bad cone index; Ctrl-C in the preparation and while driving)"
 DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 "$DM_ROOT/test/ros/test_soil_slope.py"
 say "test: the speed-made-good map on ROS (mobility_map.launch: nav_msgs/OccupancyGrid as map_server reads the file)"
 python3 "$DM_ROOT/test/ros/test_map_publisher.py"
