@@ -33,7 +33,17 @@ int WallContacts::Add(DemWall wall, const SoilParams& soil, int slots) {
   reach_.push_back(0.5 * diameter_ + margin);
   tri_begin_.push_back(static_cast<int>(tris_.size()));
   const int w = static_cast<int>(walls_.size());
-  for (int f = 0; f < static_cast<int>(wall.mesh.faces.size()); ++f) tris_.push_back({w, f});
+  for (int f = 0; f < static_cast<int>(wall.mesh.faces.size()); ++f) {
+    tris_.push_back({w, f});
+    const auto& fc = wall.mesh.faces[f];
+    const Vector3d a = wall.mesh.vertices[fc[0]], b = wall.mesh.vertices[fc[1]], c = wall.mesh.vertices[fc[2]];
+    TriBound tb;
+    tb.centroid = (a + b + c) / 3.0;
+    const Vector3d nrm = (b - a).cross(c - a);
+    tb.normal = nrm.norm() > 0.0 ? Vector3d(nrm / nrm.norm()) : Vector3d::Zero();
+    tb.rho = std::max({(a - tb.centroid).norm(), (b - tb.centroid).norm(), (c - tb.centroid).norm()}) * (1.0 + 1e-9);
+    tri_bound_.push_back(tb);
+  }
   walls_.push_back(std::move(wall));
   bins_.emplace_back();
   if (use_bins_ && static_cast<int>(walls_.back().mesh.faces.size()) >= kBinMinFaces) MakeBins(w);
@@ -275,9 +285,24 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
     const DemWall& wl = walls_[w];
     double best = 0.0;
     Vector3d q_best = Vector3d::Zero();
+    // on a binned wall, the particle in the body frame: a candidate that cannot be nearer than
+    // 0.5 D - best (less a margin: `slack`, far beyond the round-off of the frames) is passed by
+    const bool bounded = !bins_[w].start.empty();
+    const Vector3d xb = bounded ? Vector3d(wl.rotation.transpose() * (xi - wl.position)) : Vector3d::Zero();
+    const double slack = 1e-9 * D;
     for (; t < t_end && tri_at(t).wall == w; ++t) {
+      const int tt = fresh ? fresh_tris[t] : tri_of_slot_[t];
+      if (bounded) {
+        const TriBound& b = tri_bound_[tt];
+        const double reach = 0.5 * D - best + slack;
+        const Vector3d e = xb - b.centroid;
+        const double h = b.normal.dot(e);
+        if (std::abs(h) >= reach) continue;
+        const double lim = b.rho + std::sqrt(reach * reach - h * h);
+        if (e.squaredNorm() - h * h >= lim * lim) continue;
+      }
       // the triangle where the wall is now (it may have moved since the build)
-      const auto& face = wl.mesh.faces[tri_at(t).face];
+      const auto& face = wl.mesh.faces[tris_[tt].face];
       const std::vector<Vector3d>& wv = vertices_[w];
       const Vector3d q = ClosestPointOnTriangle(xi, wv[face[0]], wv[face[1]], wv[face[2]]);
       const double overlap = 0.5 * D - (xi - q).norm();
@@ -361,7 +386,7 @@ double WallContacts::Compute(ParticleStore* ps, double dt, int threads) {
 size_t WallContacts::MemoryBytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   size_t b = bytes(hist_) + bytes(touching_) + bytes(tri_start_) + bytes(tri_of_slot_) + bytes(chunk_) +
-             bytes(tri_lo_) + bytes(tri_hi_) + bytes(count_) + bytes(tris_);
+             bytes(tri_lo_) + bytes(tri_hi_) + bytes(count_) + bytes(tris_) + bytes(tri_bound_);
   for (const Bins& bn : bins_) b += bytes(bn.start) + bytes(bn.faces);
   for (const std::vector<int>& c : chunk_tris_) b += bytes(c);
   return b;

@@ -15,6 +15,12 @@
 // so its cost scales with the particles near the wall; the candidates are the same, in the same
 // order, as the scan's (DemSettings::wall_bins switches the bins off to compare).
 //
+// The deepest candidate of a binned wall: a particle near a tire has dozens of candidate triangles
+// (the mesh is fine against the particles), and few of them can be nearer than the one found so
+// far. A candidate whose distance has a lower bound at least that far (from its plane and its
+// bounding circle in the body frame, with a margin far beyond round-off) is passed by without the
+// closest point: the same triangle is chosen, with the same point, as by trying every candidate.
+//
 // The wrenches are summed in fixed chunks of slots, in slot order, and the chunks in order: the
 // same sums for any thread count, without a force per particle and wall.
 #pragma once
@@ -132,6 +138,15 @@ class WallContacts {
     std::vector<int> start, faces;  ///< CSR per cell
     int Cell(const Eigen::Vector3d& body) const;
   };
+  /// A triangle in its wall's body frame: its centroid, its unit normal (zero if it has no area)
+  /// and the largest distance of a vertex from the centroid (grown a little). The distance of a point
+  /// from the triangle is at least sqrt(h^2 + max(0, l - rho)^2), h and l the point's distances
+  /// from its plane and, in the plane, from its centroid.
+  struct TriBound {
+    using StateBulk = void;
+    Eigen::Vector3d centroid, normal;
+    double rho;
+  };
   struct WallSum {
     using StateBulk = void;
     Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
@@ -165,6 +180,7 @@ class WallContacts {
   std::vector<std::vector<Eigen::Vector3d>> vertices_, built_vertices_;  ///< world, now and at the build
   double built_particle_displacement_ = 0.0;  ///< the particles' largest distance from x_built at the build
   std::vector<WallTri> tris_;
+  std::vector<TriBound> tri_bound_;  ///< per triangle (body frame; used on binned walls)
   std::vector<int> tri_start_, tri_of_slot_;  ///< CSR: candidate triangles per slot, in wall order
   std::vector<TangentialHistory> hist_;       ///< per slot and wall
   std::vector<unsigned char> touching_;       ///< per slot and wall
