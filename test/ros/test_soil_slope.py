@@ -370,11 +370,12 @@ class Interrupted(unittest.TestCase):
 
     def test_sigint_while_driving_keeps_the_soils_figures_in_the_result(self):
         # Ctrl-C once the vehicle drives on the soil (its bag past 3 MB: the clouds and a second of
-        # driving or so); the soil read back from the prepared soil cache where an earlier run left it
+        # driving or so); the soil prepared afresh, so that the prepared-soil cache stays as the runs
+        # of SoilSlopeRuns expect it (their two runners prepare the soil alike)
         tmp = tempfile.mkdtemp(prefix='dm_soil_sigint_drive_')
         try:
             run = Run(tmp, 'drive_sigint', 'scene:=' + tiny_scene(tmp), 'dem_threads:=1', 'settle_time:=0.2',
-                      'duration:=60', 'cloud_rate:=10')
+                      'duration:=60', 'cloud_rate:=10', prepare=True)
             deadline = time.time() + 300
             while not (os.path.exists(run.bag) and os.path.getsize(run.bag) > 3e6):
                 self.assertIsNone(run.proc.poll(), run.output()[-3000:])
