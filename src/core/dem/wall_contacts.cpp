@@ -286,7 +286,7 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
     double best = 0.0;
     Vector3d q_best = Vector3d::Zero();
     // on a binned wall, the particle in the body frame: a candidate that cannot be nearer than
-    // 0.5 D - best (give or take `slack`, far beyond the round-off of the frames) is passed by
+    // 0.5 D - best (plus `slack`, far beyond the round-off of the frames) is passed by
     const bool bounded = !bins_[w].start.empty();
     const Vector3d xb = bounded ? Vector3d(wl.rotation.transpose() * (xi - wl.position)) : Vector3d::Zero();
     const double slack = 1e-9 * D;
