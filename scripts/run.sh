@@ -48,9 +48,9 @@ err = r.get('speed_error_estimate')
 print()
 if isinstance(err, (int, float)):
     print('speed_made_good: %.3f +- %.3f m/s (%.2f +- %.2f mph), %s' % (smg, err, smg / 0.44704, err / 0.44704, r['status']))
-else:
-    print('speed_made_good: %.3f m/s (%.2f mph), %s; error estimate: not measured (the result has no '
-          'speed_error_estimate)' % (smg, smg / 0.44704, r['status']))
+else:  # the level's own words (e.g. "not measured for level 'coarse'"), or none at all
+    why = err if isinstance(err, str) and err else 'not measured (the result has no speed_error_estimate)'
+    print('speed_made_good: %.3f m/s (%.2f mph), %s; error estimate: %s' % (smg, smg / 0.44704, r['status'], why))
 if r.get('terrain_model') == 'dem_soil':
     ci = r.get('cone_index_psi')
     print('soil: level %s, cone index %s, f %s; slip %s, sinkage %s m, drawbar margin %.3f' % (
