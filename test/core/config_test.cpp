@@ -10,8 +10,11 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <thread>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/input_files.h"
+#include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/mobility/mobility_run.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
@@ -157,6 +160,45 @@ TEST(Config, HalfShaftWithoutLength) {
   c.Edit("driveline.yaml", "inner_offset: 0.25", "inner_offset: 0.8");
   const std::string e = c.Error();
   EXPECT_NE(e.find("driveline.yaml: half_shaft: inner_offset and outer_inset leave no length"), std::string::npos) << e;
+}
+
+// What a checkpoint records of the files a run read: a record keeps the files read while it lives,
+// by any thread, each path once with the bytes of its first reading; records nest; a file read
+// while no record lives is kept nowhere (a process that reloads its files does not grow).
+TEST(Config, InputFileRecordsKeepTheFilesReadWhileTheyLiveEachOnce) {
+  const fs::path dir = fs::temp_directory_path() / ("dm_inputs_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return fs::absolute(dir / name).lexically_normal().string();
+  };
+  const std::string a = write("a.yaml", "x: 1\n"), b = write("b.yaml", "y: 2\n"), c = write("c.yaml", "z: 3\n");
+  YamlReader::Load(c);  // no record alive
+  InputFileRecord outer;
+  YamlReader::Load(a);
+  {
+    InputFileRecord inner;
+    YamlReader::Load(b);
+    write("a.yaml", "x: 10\n");
+    YamlReader::Load(a);
+    YamlReader::Load(b);
+    const std::vector<InputFile> in = inner.Files();
+    ASSERT_EQ(in.size(), 2u);
+    EXPECT_EQ(in[0].path, b);
+    EXPECT_EQ(in[1].path, a);
+    EXPECT_EQ(in[1].fingerprint, Fnv1a("x: 10\n", 6));  // its first reading in this record
+  }
+  std::thread([&] { YamlReader::Load(c); }).join();
+  const std::vector<InputFile> out = outer.Files();
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_EQ(out[0].path, a);
+  EXPECT_EQ(out[0].fingerprint, Fnv1a("x: 1\n", 5));
+  EXPECT_EQ(out[1].path, b);
+  EXPECT_EQ(out[1].fingerprint, Fnv1a("y: 2\n", 5));
+  EXPECT_EQ(out[2].path, c);
+  InputFileRecord later;
+  EXPECT_TRUE(later.Files().empty());
+  fs::remove_all(dir);
 }
 
 TEST(Config, RunnerExitsNonZeroWithTheMessage) {

@@ -397,7 +397,7 @@ TEST(Checkpoint, ARoadRunTakenUpAgainIsTheRunThatNeverStopped) {
   const std::string scene = WriteTemp("checkpoint_road_scene.yaml", text);
   const std::string ckpt = ::testing::TempDir() + "checkpoint_road.ckpt";
   const std::vector<std::string> overrides = {"grade_deg=10", "duration=1.5", "result.end_when_steady=false"};
-  const size_t mark = InputFileCount();
+  InputFileRecord inputs;
   const MobilityRunParams p = MobilityRunParams::Read(YamlReader::LoadWithOverrides(scene, overrides));
 
   MobilityRun whole(p);
@@ -406,7 +406,7 @@ TEST(Checkpoint, ARoadRunTakenUpAgainIsTheRunThatNeverStopped) {
   CheckpointIdentity id;
   id.scene_file = std::filesystem::absolute(scene).lexically_normal().string();
   id.overrides = overrides;
-  id.files = InputFilesSince(mark);
+  id.files = inputs.Files();
   id.executable = ExecutableFingerprint();
   ASSERT_GE(id.files.size(), 3u);  // the scene, the vehicle's files, the road
 

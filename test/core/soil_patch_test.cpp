@@ -667,7 +667,7 @@ TEST(Checkpoint, ASoilRunTakenUpAgainIsTheRunThatNeverStopped) {
                                       "terrain_overrides.levels.tiny.length=" + std::to_string(kShortBox),
                                       "terrain_overrides.patch.check_window=[0.3, 0.7]", "settle_time=0.02",
                                       "start_speed=6", "duration=0.5", "result.end_when_steady=false"};
-  const size_t mark = InputFileCount();
+  InputFileRecord inputs;
   const MobilityRunParams p = MobilityRunParams::Read(YamlReader::LoadWithOverrides(kScene, o));
   MobilityRun whole(p, PreparedStrips(100.0));
   const MobilityRunResult a = whole.Run();
@@ -676,7 +676,7 @@ TEST(Checkpoint, ASoilRunTakenUpAgainIsTheRunThatNeverStopped) {
   CheckpointIdentity id;
   id.scene_file = std::filesystem::absolute(kScene).lexically_normal().string();
   id.overrides = o;
-  id.files = InputFilesSince(mark);
+  id.files = inputs.Files();
   id.executable = ExecutableFingerprint();
 
   MobilityRun first(p, PreparedStrips(100.0));

@@ -1,8 +1,8 @@
 #include "dem_mobility/core/common/input_files.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <mutex>
-#include <set>
 
 #include "dem_mobility/core/common/state_archive.h"
 
@@ -10,7 +10,7 @@ namespace dem_mobility::core {
 
 namespace {
 std::mutex g_mutex;
-std::vector<InputFile> g_files;
+std::vector<InputFileRecord*> g_records;  // the records alive, under g_mutex
 
 std::string Absolute(const std::string& path) {
   std::error_code ec;
@@ -19,31 +19,45 @@ std::string Absolute(const std::string& path) {
 }
 }  // namespace
 
-void NoteInputFile(const std::string& path, const std::string& bytes) {
-  InputFile f{Absolute(path), Fnv1a(bytes.data(), bytes.size())};
+void InputFileRecord::Note(const InputFile& f) {
   std::lock_guard<std::mutex> lock(g_mutex);
-  g_files.push_back(std::move(f));
+  for (InputFileRecord* r : g_records) {
+    std::vector<InputFile>& files = r->files_;
+    if (std::none_of(files.begin(), files.end(), [&](const InputFile& g) { return g.path == f.path; }))
+      files.push_back(f);
+  }
+}
+
+void NoteInputFile(const std::string& path, const std::string& bytes) {
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    if (g_records.empty()) return;  // (no record alive: nothing to fingerprint for)
+  }
+  InputFileRecord::Note(InputFile{Absolute(path), Fnv1a(bytes.data(), bytes.size())});
 }
 
 void NoteInputFile(const std::string& path) {
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    if (g_records.empty()) return;
+  }
   bool ok = false;
-  InputFile f{Absolute(path), FileFingerprint(path, &ok)};
-  std::lock_guard<std::mutex> lock(g_mutex);
-  g_files.push_back(std::move(f));
+  InputFileRecord::Note(InputFile{Absolute(path), FileFingerprint(path, &ok)});
 }
 
-size_t InputFileCount() {
+InputFileRecord::InputFileRecord() {
   std::lock_guard<std::mutex> lock(g_mutex);
-  return g_files.size();
+  g_records.push_back(this);
 }
 
-std::vector<InputFile> InputFilesSince(size_t mark) {
+InputFileRecord::~InputFileRecord() {
   std::lock_guard<std::mutex> lock(g_mutex);
-  std::vector<InputFile> out;
-  std::set<std::string> seen;
-  for (size_t i = mark; i < g_files.size(); ++i)
-    if (seen.insert(g_files[i].path).second) out.push_back(g_files[i]);
-  return out;
+  g_records.erase(std::find(g_records.begin(), g_records.end(), this));
+}
+
+std::vector<InputFile> InputFileRecord::Files() const {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  return files_;
 }
 
 }  // namespace dem_mobility::core

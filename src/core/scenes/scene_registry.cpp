@@ -65,7 +65,7 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
   const auto wall0 = std::chrono::steady_clock::now();
   // what the checkpoints record of the run: the scene (read before this), then every input file
   // the run reads from here on
-  const size_t inputs_mark = InputFileCount();
+  InputFileRecord inputs;
   NoteInputFile(reader.file());
   std::unique_ptr<MobilityRun> made;
   CoSimLoopState resume;
@@ -104,7 +104,7 @@ ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) 
                                       .lexically_normal()
                                       .string();
   identity.overrides = o.overrides;
-  identity.files = restart ? restarted.files : InputFilesSince(inputs_mark);
+  identity.files = restart ? restarted.files : inputs.Files();
   identity.executable = ExecutableFingerprint();
   const TimeStepLimit& lim = run.sim().limit();
   std::printf("scene %s: grade %.1f deg, %d bodies, dt %.3g s (critical %.3g s, %s), %.1f s simulated\n",

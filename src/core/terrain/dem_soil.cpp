@@ -681,11 +681,11 @@ std::string PreparedSoilPath(const std::string& dir, const YamlReader& y, const 
 
 std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const TerrainVehicle& vehicle,
                                                  const PreparationHooks& hooks) {
-  const size_t mark = InputFileCount();
+  InputFileRecord inputs;
   const DemSoilParams p = ReadDemSoilFor(y, vehicle);
   const char* dir = std::getenv("DM_SOIL_CACHE");
   if (!dir || !*dir) return std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels, hooks);
-  const std::string path = PreparedSoilPath(dir, y, InputFilesSince(mark), vehicle);
+  const std::string path = PreparedSoilPath(dir, y, inputs.Files(), vehicle);
   std::error_code ec;
   if (std::filesystem::exists(path, ec)) {
     const auto t0 = std::chrono::steady_clock::now();
