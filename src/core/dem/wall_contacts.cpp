@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/geometry/trimesh.h"
@@ -283,7 +284,9 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
       continue;
     }
     const DemWall& wl = walls_[w];
-    double best = 0.0;
+    // the nearest candidate, by its squared distance (the first of equals, in the candidates'
+    // order), and its overlap (0 while none overlaps): one square root per nearer candidate
+    double best = 0.0, best_d2 = std::numeric_limits<double>::infinity();
     Vector3d q_best = Vector3d::Zero();
     // on a binned wall, the particle in the body frame: a candidate that cannot be nearer than
     // 0.5 D - best (plus `slack`, far beyond the round-off of the frames) is passed by
@@ -293,22 +296,26 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
     for (; t < t_end && tri_at(t).wall == w; ++t) {
       const int tt = fresh ? fresh_tris[t] : tri_of_slot_[t];
       if (bounded) {
+        // passed by where l >= rho + s, s = sqrt(reach^2 - h^2) (TriBound), squared twice so
+        // that no root is taken: l^2 - rho^2 - s^2 >= 2 rho s
         const TriBound& b = tri_bound_[tt];
         const double reach = 0.5 * D - best + slack;
         const Vector3d e = xb - b.centroid;
         const double h = b.normal.dot(e);
         if (std::abs(h) >= reach) continue;
-        const double lim = b.rho + std::sqrt(reach * reach - h * h);
-        if (e.squaredNorm() - h * h >= lim * lim) continue;
+        const double s2 = reach * reach - h * h;
+        const double a = (e.squaredNorm() - h * h) - b.rho * b.rho - s2;
+        if (a >= 0.0 && a * a >= 4.0 * b.rho * b.rho * s2) continue;
       }
       // the triangle where the wall is now (it may have moved since the build)
       const auto& face = wl.mesh.faces[tris_[tt].face];
       const std::vector<Vector3d>& wv = vertices_[w];
       const Vector3d q = ClosestPointOnTriangle(xi, wv[face[0]], wv[face[1]], wv[face[2]]);
-      const double overlap = 0.5 * D - (xi - q).norm();
-      if (overlap > best) {
-        best = overlap;
+      const double d2 = (xi - q).squaredNorm();
+      if (d2 < best_d2) {
+        best_d2 = d2;
         q_best = q;
+        best = std::max(0.0, 0.5 * D - std::sqrt(d2));
       }
     }
     const double d = best - pi;
