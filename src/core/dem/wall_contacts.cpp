@@ -133,19 +133,38 @@ void WallContacts::PermuteSlots(const std::vector<int>& order) {
 
 void WallContacts::UpdateVertices() {
   vertices_.resize(walls_.size());
+  displacement_.assign(walls_.size(), 0.0);
   for (size_t w = 0; w < walls_.size(); ++w) {
     const DemWall& wl = walls_[w];
-    vertices_[w].resize(wl.mesh.vertices.size());
-    for (size_t k = 0; k < wl.mesh.vertices.size(); ++k) vertices_[w][k] = wl.position + wl.rotation * wl.mesh.vertices[k];
+    const size_t nv = wl.mesh.vertices.size();
+    std::vector<Vector3d>& now = vertices_[w];
+    now.resize(nv);
+    if (w < built_vertices_.size() && built_vertices_[w].size() == nv) {
+      const std::vector<Vector3d>& built = built_vertices_[w];
+      double m2 = 0.0;
+      for (size_t k = 0; k < nv; ++k) {
+        now[k] = wl.position + wl.rotation * wl.mesh.vertices[k];
+        m2 = std::max(m2, (now[k] - built[k]).squaredNorm());
+      }
+      displacement_[w] = std::sqrt(m2);
+    } else {
+      for (size_t k = 0; k < nv; ++k) now[k] = wl.position + wl.rotation * wl.mesh.vertices[k];
+    }
+  }
+}
+
+void WallContacts::Displacements() {
+  displacement_.assign(walls_.size(), 0.0);
+  for (size_t w = 0; w < walls_.size() && w < vertices_.size() && w < built_vertices_.size(); ++w) {
+    double m2 = 0.0;
+    for (size_t k = 0; k < vertices_[w].size(); ++k)
+      m2 = std::max(m2, (vertices_[w][k] - built_vertices_[w][k]).squaredNorm());
+    displacement_[w] = std::sqrt(m2);
   }
 }
 
 double WallContacts::WallDisplacement(int w) const {
-  if (w >= static_cast<int>(vertices_.size()) || w >= static_cast<int>(built_vertices_.size())) return 0.0;
-  double m2 = 0.0;
-  for (size_t k = 0; k < vertices_[w].size(); ++k)
-    m2 = std::max(m2, (vertices_[w][k] - built_vertices_[w][k]).squaredNorm());
-  return std::sqrt(m2);
+  return w < static_cast<int>(displacement_.size()) ? displacement_[w] : 0.0;
 }
 
 double WallContacts::MaxWallDisplacement(bool fast) const {
@@ -194,6 +213,7 @@ void WallContacts::Build(const ParticleStore& ps, int threads, double particle_d
   const int n = ps.slots();
   UpdateVertices();
   built_vertices_ = vertices_;
+  displacement_.assign(walls_.size(), 0.0);
   built_particle_displacement_ = particle_displacement;
   // each triangle's world box, grown by its wall's reach: the cheap test before the distance
   const int T = static_cast<int>(tris_.size());
@@ -284,8 +304,7 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
       continue;
     }
     const DemWall& wl = walls_[w];
-    // the nearest candidate, by its squared distance (the first of equals, in the candidates'
-    // order), and its overlap (0 while none overlaps): one square root per nearer candidate
+    // the deepest candidate's overlap (0 while none overlaps) and its squared distance
     double best = 0.0, best_d2 = std::numeric_limits<double>::infinity();
     Vector3d q_best = Vector3d::Zero();
     // on a binned wall, the particle in the body frame: a candidate that cannot be nearer than
@@ -311,11 +330,16 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
       const auto& face = wl.mesh.faces[tris_[tt].face];
       const std::vector<Vector3d>& wv = vertices_[w];
       const Vector3d q = ClosestPointOnTriangle(xi, wv[face[0]], wv[face[1]], wv[face[2]]);
+      // deeper than the deepest so far only if nearer than it: the root only then (a candidate
+      // as deep as it is passed by, as before: the first of the deepest stays)
       const double d2 = (xi - q).squaredNorm();
       if (d2 < best_d2) {
-        best_d2 = d2;
-        q_best = q;
-        best = std::max(0.0, 0.5 * D - std::sqrt(d2));
+        const double overlap = 0.5 * D - std::sqrt(d2);
+        if (overlap > best) {
+          best = overlap;
+          best_d2 = d2;
+          q_best = q;
+        }
       }
     }
     const double d = best - pi;
@@ -393,7 +417,8 @@ double WallContacts::Compute(ParticleStore* ps, double dt, int threads) {
 size_t WallContacts::MemoryBytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   size_t b = bytes(hist_) + bytes(touching_) + bytes(tri_start_) + bytes(tri_of_slot_) + bytes(chunk_) +
-             bytes(tri_lo_) + bytes(tri_hi_) + bytes(count_) + bytes(tris_) + bytes(tri_bound_);
+             bytes(tri_lo_) + bytes(tri_hi_) + bytes(count_) + bytes(tris_) + bytes(tri_bound_) +
+             bytes(displacement_);
   for (const Bins& bn : bins_) b += bytes(bn.start) + bytes(bn.faces);
   for (const std::vector<int>& c : chunk_tris_) b += bytes(c);
   return b;
@@ -435,6 +460,7 @@ void WallContacts::Io(Ar& ar) {
       if (tri_start_[s] < 0 || tri_start_[s] > static_cast<int>(tri_of_slot_.size()) ||
           (s > 0 && tri_start_[s] < tri_start_[s - 1]))
         ar.Fail("a slot's candidates lie beyond the candidates");
+    Displacements();
   }
 }
 template void WallContacts::Io(StateWriter&);

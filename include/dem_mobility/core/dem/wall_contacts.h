@@ -90,7 +90,8 @@ class WallContacts {
   void ClearSlot(int s);
   /// Follows the store's permutation (new slot s holds old slot order[s]).
   void PermuteSlots(const std::vector<int>& order);
-  /// The walls' world vertices from their present poses.
+  /// The walls' world vertices from their present poses, and each wall's largest vertex distance
+  /// from the wall build (WallDisplacement) in the same pass.
   void UpdateVertices();
   /// Whether the candidates may miss a contact once the particles have moved up to
   /// `particle_displacement` from x_built.
@@ -153,6 +154,8 @@ class WallContacts {
     double power = 0.0, normal = 0.0;
     int contacts = 0;
   };
+  /// displacement_ from vertices_ and built_vertices_ (after a checkpoint is read).
+  void Displacements();
   void ClearHistory(size_t hw) {
     if (touching_[hw]) {
       hist_[hw] = TangentialHistory();
@@ -178,6 +181,7 @@ class WallContacts {
   std::vector<DemWall> walls_;
   std::vector<SoilContactLaw> law_;  ///< the soil law with each wall's friction
   std::vector<std::vector<Eigen::Vector3d>> vertices_, built_vertices_;  ///< world, now and at the build
+  std::vector<double> displacement_;  ///< per wall: its largest vertex distance between the two
   double built_particle_displacement_ = 0.0;  ///< the particles' largest distance from x_built at the build
   std::vector<WallTri> tris_;
   std::vector<TriBound> tri_bound_;  ///< per triangle (body frame; used on binned walls)
