@@ -194,6 +194,9 @@ bool WallContacts::Near(const Vector3d& x, int t) const {
 
 void WallContacts::SlotCandidates(const Vector3d& x, std::vector<int>* out) const {
   for (int w = 0; w < size(); ++w) {
+    // outside the box of the wall's triangles' boxes no triangle is near (a tire above the soil,
+    // a wall at the other end of the bin): passed by before its bins or its triangles
+    if (!((x.array() >= wall_lo_[w].array()).all() && (x.array() <= wall_hi_[w].array()).all())) continue;
     const Bins& b = bins_[w];
     if (b.start.empty()) {
       const int end = w + 1 < size() ? tri_begin_[w + 1] : static_cast<int>(tris_.size());
@@ -225,6 +228,13 @@ void WallContacts::Build(const ParticleStore& ps, int threads, double particle_d
     const std::vector<Vector3d>& wv = vertices_[tr.wall];
     tri_lo_[t] = wv[face[0]].cwiseMin(wv[face[1]]).cwiseMin(wv[face[2]]).array() - reach_[tr.wall];
     tri_hi_[t] = wv[face[0]].cwiseMax(wv[face[1]]).cwiseMax(wv[face[2]]).array() + reach_[tr.wall];
+  }
+  wall_lo_.assign(walls_.size(), Vector3d::Constant(std::numeric_limits<double>::infinity()));
+  wall_hi_.assign(walls_.size(), Vector3d::Constant(-std::numeric_limits<double>::infinity()));
+  for (int t = 0; t < T; ++t) {
+    const int w = tris_[t].wall;
+    wall_lo_[w] = wall_lo_[w].cwiseMin(tri_lo_[t]);
+    wall_hi_[w] = wall_hi_[w].cwiseMax(tri_hi_[t]);
   }
   // each live slot's candidates, chunk by chunk of slots (in slot order within a chunk), then the
   // chunks joined in order: the same lists for any thread count
@@ -417,8 +427,8 @@ double WallContacts::Compute(ParticleStore* ps, double dt, int threads) {
 size_t WallContacts::MemoryBytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   size_t b = bytes(hist_) + bytes(touching_) + bytes(tri_start_) + bytes(tri_of_slot_) + bytes(chunk_) +
-             bytes(tri_lo_) + bytes(tri_hi_) + bytes(count_) + bytes(tris_) + bytes(tri_bound_) +
-             bytes(displacement_);
+             bytes(tri_lo_) + bytes(tri_hi_) + bytes(wall_lo_) + bytes(wall_hi_) + bytes(count_) + bytes(tris_) +
+             bytes(tri_bound_) + bytes(displacement_);
   for (const Bins& bn : bins_) b += bytes(bn.start) + bytes(bn.faces);
   for (const std::vector<int>& c : chunk_tris_) b += bytes(c);
   return b;

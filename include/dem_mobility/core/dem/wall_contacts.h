@@ -176,6 +176,7 @@ class WallContacts {
   std::vector<Bins> bins_;
   std::vector<int> tri_begin_;          ///< per wall: its first index in tris_
   std::vector<Eigen::Vector3d> tri_lo_, tri_hi_;  ///< per triangle: its world box at the build, grown by the reach
+  std::vector<Eigen::Vector3d> wall_lo_, wall_hi_;  ///< per wall: the box of its triangles' boxes
   std::vector<std::vector<int>> chunk_tris_;      ///< per chunk of slots at a build: the candidates
   std::vector<int> count_;                        ///< per slot at a build: its number of candidates
   std::vector<DemWall> walls_;
