@@ -2,12 +2,15 @@
 // thread counts, the time-step guard and the watchdogs.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <random>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/dem/dem_system.h"
+#include "dem_mobility/core/dem/particle_store.h"
+#include "dem_mobility/core/dem/wall_contacts.h"
 #include "dem_test_soils.h"
 
 namespace dem_mobility::core {
@@ -316,6 +319,67 @@ TEST(Dem, FastWallStrikesEveryParticleWithWallOnlyBuilds) {
   // the slow plate rebuilt the lists every half skin it moved; the fast one only its candidates
   EXPECT_LT(fast.neighbour_builds, slow.neighbour_builds);
   EXPECT_GT(fast.wall_builds, fast.neighbour_builds);
+}
+
+// A fast wall's displacement since its build (what decides its candidates' next build) is bounded
+// from its pose, |p - p_b| + ||R - R_b||_F max|v|, without its vertices: never below any vertex's
+// distance, whatever the motion; exact for a translation; for a turn by theta about an axis square
+// to a farthest vertex, sqrt(2) times that vertex's 2 r sin(theta / 2) (||R - R_b||_F =
+// 2 sqrt(2) sin(theta / 2)). A slow wall's is its vertices' own largest distance.
+TEST(Dem, AFastWallsDisplacementBoundsEveryVertexFromItsPose) {
+  const SoilParams p = Nominal();
+  // a ring of vertices at radius 0.45 m in the x-z plane (a wheel turning about y), two off-plane
+  std::vector<Vector3d> v;
+  for (int k = 0; k < 24; ++k) v.push_back(0.45 * Vector3d(std::cos(k * M_PI / 12), 0.0, std::sin(k * M_PI / 12)));
+  v.push_back({0.1, 0.2, 0.05});
+  v.push_back({-0.2, -0.15, 0.1});
+  auto wall = [&](bool fast) {
+    DemWall w;
+    w.name = fast ? "fast" : "slow";
+    w.mesh.vertices = v;
+    for (int k = 0; k + 2 < static_cast<int>(v.size()); ++k) w.mesh.faces.push_back({k, k + 1, k + 2});
+    w.position = Vector3d(12.0, -3.0, 0.6);
+    w.fast = fast;
+    return w;
+  };
+  const double r = 0.45;
+  WallContacts walls(1.1 * p.diameter, p.diameter);
+  const int fast = walls.Add(wall(true), p, 0), slow = walls.Add(wall(false), p, 0);
+  const ParticleStore none;
+  walls.Build(none, 1, 0.0);
+  const Vector3d p_b = walls.wall(fast).position;
+  const Eigen::Matrix3d R_b = walls.wall(fast).rotation;
+  auto move = [&](const Vector3d& dp, const Eigen::Matrix3d& dR) {
+    for (int w : {fast, slow}) {
+      walls.wall(w).position = p_b + dp;
+      walls.wall(w).rotation = dR * R_b;
+    }
+    walls.UpdateVertices();
+    double most = 0.0;  // the largest distance of a vertex from where it was at the build
+    for (const Vector3d& u : v) most = std::max(most, ((p_b + dp) + dR * R_b * u - (p_b + R_b * u)).norm());
+    return most;
+  };
+  // a translation: the bound is the distance moved
+  double most = move(Vector3d(0.003, -0.001, 0.002), Eigen::Matrix3d::Identity());
+  EXPECT_NEAR(walls.WallDisplacement(fast), most, 3e-11);  // (the round-off margin: 1e-12 (|p| + |p_b| + r))
+  EXPECT_NEAR(walls.WallDisplacement(slow), most, 1e-15);
+  // a turn about y (the ring's axis): sqrt(2) times the rim's chord
+  for (double theta : {1e-4, 0.01, 0.3}) {
+    most = move(Vector3d::Zero(), Eigen::AngleAxisd(theta, Vector3d::UnitY()).toRotationMatrix());
+    EXPECT_NEAR(most, 2.0 * r * std::sin(0.5 * theta), 1e-12);
+    EXPECT_NEAR(walls.WallDisplacement(fast), std::sqrt(2.0) * most, 3e-11 + 1e-9 * most) << theta;
+    EXPECT_NEAR(walls.WallDisplacement(slow), most, 1e-12) << theta;
+  }
+  // random rigid motions: never below any vertex's distance
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 2000; ++k) {
+    const double scale = std::pow(10.0, -6.0 + 5.0 * (0.5 + 0.5 * u(rng)));
+    const Vector3d dp = scale * Vector3d(u(rng), u(rng), u(rng));
+    const Vector3d axis = Vector3d(u(rng), u(rng), u(rng)).normalized();
+    most = move(dp, Eigen::AngleAxisd(scale * 10.0 * u(rng), axis).toRotationMatrix());
+    ASSERT_GE(walls.WallDisplacement(fast), most) << k;
+  }
 }
 
 }  // namespace

@@ -33,6 +33,9 @@ int WallContacts::Add(DemWall wall, const SoilParams& soil, int slots) {
   margin_.push_back(margin);
   reach_.push_back(0.5 * diameter_ + margin);
   tri_begin_.push_back(static_cast<int>(tris_.size()));
+  double radius = 0.0;
+  for (const Vector3d& v : wall.mesh.vertices) radius = std::max(radius, v.norm());
+  radius_.push_back(radius);
   const int w = static_cast<int>(walls_.size());
   for (int f = 0; f < static_cast<int>(wall.mesh.faces.size()); ++f) {
     tris_.push_back({w, f});
@@ -131,11 +134,15 @@ void WallContacts::PermuteSlots(const std::vector<int>& order) {
   core::PermuteSlots(&touching_, order, walls_.size());
 }
 
-void WallContacts::UpdateVertices() {
+void WallContacts::UpdateVertices(bool all) {
   vertices_.resize(walls_.size());
   displacement_.assign(walls_.size(), 0.0);
   for (size_t w = 0; w < walls_.size(); ++w) {
     const DemWall& wl = walls_[w];
+    if (wl.fast && !all) {
+      displacement_[w] = FastDisplacement(static_cast<int>(w));
+      continue;
+    }
     const size_t nv = wl.mesh.vertices.size();
     std::vector<Vector3d>& now = vertices_[w];
     now.resize(nv);
@@ -153,9 +160,21 @@ void WallContacts::UpdateVertices() {
   }
 }
 
+double WallContacts::FastDisplacement(int w) const {
+  if (w >= static_cast<int>(built_position_.size())) return 0.0;  // (not built yet)
+  const DemWall& wl = walls_[w];
+  const double moved = (wl.position - built_position_[w]).norm() + (wl.rotation - built_rotation_[w]).norm() * radius_[w];
+  // (a vertex is where p + R v rounds to: far less than 1e-12 of |p| + |v| from it)
+  return moved + 1e-12 * (wl.position.norm() + built_position_[w].norm() + radius_[w]);
+}
+
 void WallContacts::Displacements() {
   displacement_.assign(walls_.size(), 0.0);
   for (size_t w = 0; w < walls_.size() && w < vertices_.size() && w < built_vertices_.size(); ++w) {
+    if (walls_[w].fast) {
+      displacement_[w] = FastDisplacement(static_cast<int>(w));
+      continue;
+    }
     double m2 = 0.0;
     for (size_t k = 0; k < vertices_[w].size(); ++k)
       m2 = std::max(m2, (vertices_[w][k] - built_vertices_[w][k]).squaredNorm());
@@ -214,9 +233,15 @@ void WallContacts::SlotCandidates(const Vector3d& x, std::vector<int>* out) cons
 
 void WallContacts::Build(const ParticleStore& ps, int threads, double particle_displacement) {
   const int n = ps.slots();
-  UpdateVertices();
+  UpdateVertices(true);
   built_vertices_ = vertices_;
   displacement_.assign(walls_.size(), 0.0);
+  built_position_.resize(walls_.size());
+  built_rotation_.resize(walls_.size());
+  for (size_t w = 0; w < walls_.size(); ++w) {
+    built_position_[w] = walls_[w].position;
+    built_rotation_[w] = walls_[w].rotation;
+  }
   built_particle_displacement_ = particle_displacement;
   // each triangle's world box, grown by its wall's reach: the cheap test before the distance
   const int T = static_cast<int>(tris_.size());
@@ -336,10 +361,19 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
         const double a = (e.squaredNorm() - h * h) - b.rho * b.rho - s2;
         if (a >= 0.0 && a * a >= 4.0 * b.rho * b.rho * s2) continue;
       }
-      // the triangle where the wall is now (it may have moved since the build)
+      // the triangle where the wall is now (it may have moved since the build; a fast wall's
+      // vertices are taken here, as UpdateVertices takes a slow one's)
       const auto& face = wl.mesh.faces[tris_[tt].face];
-      const std::vector<Vector3d>& wv = vertices_[w];
-      const Vector3d q = ClosestPointOnTriangle(xi, wv[face[0]], wv[face[1]], wv[face[2]]);
+      Vector3d q;
+      if (wl.fast) {
+        const std::vector<Vector3d>& mv = wl.mesh.vertices;
+        const Vector3d a = wl.position + wl.rotation * mv[face[0]], b = wl.position + wl.rotation * mv[face[1]],
+                       c = wl.position + wl.rotation * mv[face[2]];
+        q = ClosestPointOnTriangle(xi, a, b, c);
+      } else {
+        const std::vector<Vector3d>& wv = vertices_[w];
+        q = ClosestPointOnTriangle(xi, wv[face[0]], wv[face[1]], wv[face[2]]);
+      }
       // deeper than the deepest so far only if nearer than it: the root only then (a candidate
       // as deep as it is passed by, as before: the first of the deepest stays)
       const double d2 = (xi - q).squaredNorm();
@@ -428,7 +462,8 @@ size_t WallContacts::MemoryBytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   size_t b = bytes(hist_) + bytes(touching_) + bytes(tri_start_) + bytes(tri_of_slot_) + bytes(chunk_) +
              bytes(tri_lo_) + bytes(tri_hi_) + bytes(wall_lo_) + bytes(wall_hi_) + bytes(count_) + bytes(tris_) +
-             bytes(tri_bound_) + bytes(displacement_);
+             bytes(tri_bound_) + bytes(displacement_) + bytes(radius_) + bytes(built_position_) +
+             bytes(built_rotation_);
   for (const Bins& bn : bins_) b += bytes(bn.start) + bytes(bn.faces);
   for (const std::vector<int>& c : chunk_tris_) b += bytes(c);
   return b;
@@ -446,7 +481,8 @@ void WallContacts::Io(Ar& ar) {
        w.moment, w.normal_force, w.contacts);
   }
   ar.Tag("wall_candidates");
-  ar(builds_, tri_lo_, tri_hi_, chunk_tris_, count_, vertices_, built_vertices_, built_particle_displacement_,
+  ar(builds_, tri_lo_, tri_hi_, chunk_tris_, count_, vertices_, built_vertices_, built_position_, built_rotation_,
+     built_particle_displacement_,
      tri_start_, tri_of_slot_, hist_, touching_, chunk_);
   if constexpr (Ar::kLoading) {
     if (hist_.size() != touching_.size()) ar.Fail("the wall histories differ in length");
@@ -457,6 +493,9 @@ void WallContacts::Io(Ar& ar) {
     for (size_t w = 0; w < built_vertices_.size(); ++w)
       if (built_vertices_[w].size() != walls_[w].mesh.vertices.size())
         ar.Fail("a wall's vertices at its build do not match its mesh");
+    if ((!built_position_.empty() && built_position_.size() != walls_.size()) ||
+        built_rotation_.size() != built_position_.size())
+      ar.Fail("the walls' poses at their build do not match the walls");
     const int T = static_cast<int>(tris_.size());
     for (int t : tri_of_slot_)
       if (t < 0 || t >= T) ar.Fail("a candidate triangle lies beyond the walls'");

@@ -90,9 +90,11 @@ class WallContacts {
   void ClearSlot(int s);
   /// Follows the store's permutation (new slot s holds old slot order[s]).
   void PermuteSlots(const std::vector<int>& order);
-  /// The walls' world vertices from their present poses, and each wall's largest vertex distance
-  /// from the wall build (WallDisplacement) in the same pass.
-  void UpdateVertices();
+  /// The slow walls' world vertices from their present poses, and each wall's largest vertex
+  /// distance from the wall build (WallDisplacement) in the same pass; a fast wall's distance is
+  /// bounded from its pose (FastDisplacement) and its vertices are taken where a contact needs them
+  /// (`all`: every wall's vertices, as a build needs).
+  void UpdateVertices(bool all = false);
   /// Whether the candidates may miss a contact once the particles have moved up to
   /// `particle_displacement` from x_built.
   bool NeedsBuild(double particle_displacement) const;
@@ -154,8 +156,11 @@ class WallContacts {
     double power = 0.0, normal = 0.0;
     int contacts = 0;
   };
-  /// displacement_ from vertices_ and built_vertices_ (after a checkpoint is read).
+  /// displacement_ from vertices_ and built_vertices_, and from the poses (after a checkpoint is read).
   void Displacements();
+  /// A bound on the distance of any vertex of fast wall w from where it was at the build, from the
+  /// rigid motion since: |p - p_b| + ||R - R_b||_F max|v| (v in the body frame), plus the round-off.
+  double FastDisplacement(int w) const;
   void ClearHistory(size_t hw) {
     if (touching_[hw]) {
       hist_[hw] = TangentialHistory();
@@ -183,6 +188,9 @@ class WallContacts {
   std::vector<SoilContactLaw> law_;  ///< the soil law with each wall's friction
   std::vector<std::vector<Eigen::Vector3d>> vertices_, built_vertices_;  ///< world, now and at the build
   std::vector<double> displacement_;  ///< per wall: its largest vertex distance between the two
+  std::vector<double> radius_;        ///< per wall: its largest vertex distance from the body origin
+  std::vector<Eigen::Vector3d> built_position_;  ///< per wall: its pose at the build
+  std::vector<Eigen::Matrix3d> built_rotation_;
   double built_particle_displacement_ = 0.0;  ///< the particles' largest distance from x_built at the build
   std::vector<WallTri> tris_;
   std::vector<TriBound> tri_bound_;  ///< per triangle (body frame; used on binned walls)
