@@ -460,7 +460,7 @@ void PlasticExchangeScalar(const SoilContactLaw& law, double D, int threads, con
 }
 
 struct LedgerConstants {
-  double D, k_n, d0, dp;
+  double D, k_n, d0, dp, inv_dp, inv_d0_dp;
 };
 
 // One block's lanes: the pair's separation, its plastic sums and adhesions after (1) and before (0)
@@ -483,8 +483,8 @@ template <bool kAdhesion>
     const double reach = c.D - std::min(p1, p0);
     const bool in = (reach > 0.0) & (r2 < reach * reach);
     const double gap = c.D - std::sqrt(r2);
-    const double after = NormalEnergyOf<kAdhesion>(c.k_n, c.d0, c.dp, gap - p1, b->a1[l]);
-    const double before = NormalEnergyOf<kAdhesion>(c.k_n, c.d0, c.dp, gap - p0, b->a0[l]);
+    const double after = NormalEnergyOf<kAdhesion>(c.k_n, c.d0, c.dp, c.inv_dp, c.inv_d0_dp, gap - p1, b->a1[l]);
+    const double before = NormalEnergyOf<kAdhesion>(c.k_n, c.d0, c.dp, c.inv_dp, c.inv_d0_dp, gap - p0, b->a0[l]);
     b->de[l] = in ? after - before : 0.0;
   }
 }
@@ -665,7 +665,7 @@ void PlasticExchangeEnergies(const SoilContactLaw& law, double diameter, int thr
                              const NeighbourList& lists, const PlasticChange* rec, double* de, PairKernel kernel) {
   const LedgerFunction range = InstanceOf<LedgerFunction>(kernel, LedgerRangeAvx512, LedgerRangeAvx2, LedgerRangeBaseline);
   if (!range) return PlasticExchangeScalar(law, diameter, threads, ps, lists, rec, de);
-  const LedgerConstants c{diameter, law.k_n, law.d0, law.dp};
+  const LedgerConstants c{diameter, law.k_n, law.d0, law.dp, law.inv_dp, law.inv_d0_dp};
   const bool adhesion = law.cohesion && law.dp > 0.0;
   const int n = ps.slots();
   constexpr int kChunk = 1024;  // slots per task (each slot's sum is its own: any split gives the same sums)

@@ -163,7 +163,8 @@ void WallContacts::UpdateVertices(bool all) {
 double WallContacts::FastDisplacement(int w) const {
   if (w >= static_cast<int>(built_position_.size())) return 0.0;  // (not built yet)
   const DemWall& wl = walls_[w];
-  const double moved = (wl.position - built_position_[w]).norm() + (wl.rotation - built_rotation_[w]).norm() * radius_[w];
+  const double moved =
+      (wl.position - built_position_[w]).norm() + (wl.rotation - built_rotation_[w]).norm() * radius_[w];
   // (a vertex is where p + R v rounds to: far less than 1e-12 of |p| + |v| from it)
   return moved + 1e-12 * (wl.position.norm() + built_position_[w].norm() + radius_[w]);
 }
@@ -367,9 +368,9 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
       Vector3d q;
       if (wl.fast) {
         const std::vector<Vector3d>& mv = wl.mesh.vertices;
-        const Vector3d a = wl.position + wl.rotation * mv[face[0]], b = wl.position + wl.rotation * mv[face[1]],
-                       c = wl.position + wl.rotation * mv[face[2]];
-        q = ClosestPointOnTriangle(xi, a, b, c);
+        const Vector3d v0 = wl.position + wl.rotation * mv[face[0]], v1 = wl.position + wl.rotation * mv[face[1]],
+                       v2 = wl.position + wl.rotation * mv[face[2]];
+        q = ClosestPointOnTriangle(xi, v0, v1, v2);
       } else {
         const std::vector<Vector3d>& wv = vertices_[w];
         q = ClosestPointOnTriangle(xi, wv[face[0]], wv[face[1]], wv[face[2]]);

@@ -28,15 +28,18 @@ double PairEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const Neighb
 /// branch gives): the plastic ledger runs it twice for every listed pair, on the lanes of a vector
 /// block (pair_sweep.h, PlasticExchangeEnergies), and in a packed bed `d` sits about d0, where a
 /// branch is mispredicted half the time.
+/// `inv_dp`, `inv_d0_dp`: 1 / dp and 1 / (d0 - dp) (SoilContactLaw's, 0 where undefined): no
+/// division in the ledger's lanes.
 template <bool kAdhesion>
-[[gnu::always_inline]] inline double NormalEnergyOf(double k_n, double d0, double dp, double d, double fmax) {
+[[gnu::always_inline]] inline double NormalEnergyOf(double k_n, double d0, double dp, double inv_dp, double inv_d0_dp,
+                                                    double d, double fmax) {
   const double over = std::max(d - d0, 0.0);
   double u = 0.5 * k_n * over * over;
   if constexpr (kAdhesion) {
     const double f = std::max(fmax, 0.0), a = std::min(d, d0), past = a - dp;
-    const double rising = 0.5 * f * a * a / dp;
-    // (where a passes dp, d0 > dp: the quotient of d0 == dp is never selected)
-    const double falling = 0.5 * f * dp + f * past - 0.5 * f * past * past / (d0 - dp);
+    const double rising = 0.5 * f * a * a * inv_dp;
+    // (where a passes dp, d0 > dp: the arm of d0 == dp is never selected)
+    const double falling = 0.5 * f * dp + f * past - 0.5 * f * past * past * inv_d0_dp;
     u -= a <= dp ? rising : falling;
   }
   return d > 0.0 ? u : 0.0;
@@ -45,8 +48,9 @@ template <bool kAdhesion>
 /// plastic deformations taken off) and largest adhesion `fmax`: the part the law's plastic changes
 /// move.
 inline double NormalEnergy(const SoilContactLaw& law, double d, double fmax) {
-  return law.cohesion && law.dp > 0.0 ? NormalEnergyOf<true>(law.k_n, law.d0, law.dp, d, fmax)
-                                      : NormalEnergyOf<false>(law.k_n, law.d0, law.dp, d, fmax);
+  return law.cohesion && law.dp > 0.0
+             ? NormalEnergyOf<true>(law.k_n, law.d0, law.dp, law.inv_dp, law.inv_d0_dp, d, fmax)
+             : NormalEnergyOf<false>(law.k_n, law.d0, law.dp, law.inv_dp, law.inv_d0_dp, d, fmax);
 }
 /// Kinetic, gravitational and elastic energy of all live particles.
 EnergyReport MechanicalEnergy(const DemEnergyTerms& e, const ParticleStore& ps, const NeighbourList& lists);
