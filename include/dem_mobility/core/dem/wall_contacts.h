@@ -106,9 +106,10 @@ class WallContacts {
   double Compute(ParticleStore* ps, double dt, int threads);
 
   /// The largest distance of a vertex of the fast (or the slow) walls from where it was at the
-  /// wall build.
+  /// wall build (for the fast ones, its bound from their poses: FastDisplacement).
   double MaxWallDisplacement(bool fast) const;
-  /// The largest distance of a vertex of wall w from where it was at the wall build.
+  /// The largest distance of a vertex of wall w from where it was at the wall build, as of the last
+  /// UpdateVertices (a fast wall's: its bound from its pose, never below it).
   double WallDisplacement(int w) const;
   double margin(int w) const { return margin_[w]; }
   bool binned(int w) const { return !bins_[w].start.empty(); }
