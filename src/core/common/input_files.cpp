@@ -12,6 +12,11 @@ namespace {
 std::mutex g_mutex;
 std::vector<InputFileRecord*> g_records;  // the records alive, under g_mutex
 
+bool AnyRecord() {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  return !g_records.empty();
+}
+
 std::string Absolute(const std::string& path) {
   std::error_code ec;
   const std::filesystem::path a = std::filesystem::absolute(path, ec);
@@ -29,18 +34,12 @@ void InputFileRecord::Note(const InputFile& f) {
 }
 
 void NoteInputFile(const std::string& path, const std::string& bytes) {
-  {
-    std::lock_guard<std::mutex> lock(g_mutex);
-    if (g_records.empty()) return;  // (no record alive: nothing to fingerprint for)
-  }
+  if (!AnyRecord()) return;  // (nothing to fingerprint for)
   InputFileRecord::Note(InputFile{Absolute(path), Fnv1a(bytes.data(), bytes.size())});
 }
 
 void NoteInputFile(const std::string& path) {
-  {
-    std::lock_guard<std::mutex> lock(g_mutex);
-    if (g_records.empty()) return;
-  }
+  if (!AnyRecord()) return;
   bool ok = false;
   InputFileRecord::Note(InputFile{Absolute(path), FileFingerprint(path, &ok)});
 }

@@ -13,6 +13,12 @@ namespace dem_mobility::core {
 
 using Eigen::Vector3d;
 
+namespace {
+// A vertex of a wall where its pose puts it (the one expression for every wall vertex, so that a
+// fast wall's vertices taken in ComputeSlot are those of its build, bit for bit).
+inline Vector3d WorldVertex(const DemWall& wl, int k) { return wl.position + wl.rotation * wl.mesh.vertices[k]; }
+}  // namespace
+
 DemWall MakeQuadWall(const std::string& name, const Vector3d& o, const Vector3d& e1, const Vector3d& e2) {
   DemWall w;
   w.name = name;
@@ -136,28 +142,14 @@ void WallContacts::PermuteSlots(const std::vector<int>& order) {
 
 void WallContacts::UpdateVertices(bool all) {
   vertices_.resize(walls_.size());
-  displacement_.assign(walls_.size(), 0.0);
   for (size_t w = 0; w < walls_.size(); ++w) {
     const DemWall& wl = walls_[w];
-    if (wl.fast && !all) {
-      displacement_[w] = FastDisplacement(static_cast<int>(w));
-      continue;
-    }
-    const size_t nv = wl.mesh.vertices.size();
+    if (wl.fast && !all) continue;  // (taken where a contact needs them: ComputeSlot)
     std::vector<Vector3d>& now = vertices_[w];
-    now.resize(nv);
-    if (w < built_vertices_.size() && built_vertices_[w].size() == nv) {
-      const std::vector<Vector3d>& built = built_vertices_[w];
-      double m2 = 0.0;
-      for (size_t k = 0; k < nv; ++k) {
-        now[k] = wl.position + wl.rotation * wl.mesh.vertices[k];
-        m2 = std::max(m2, (now[k] - built[k]).squaredNorm());
-      }
-      displacement_[w] = std::sqrt(m2);
-    } else {
-      for (size_t k = 0; k < nv; ++k) now[k] = wl.position + wl.rotation * wl.mesh.vertices[k];
-    }
+    now.resize(wl.mesh.vertices.size());
+    for (size_t k = 0; k < now.size(); ++k) now[k] = WorldVertex(wl, static_cast<int>(k));
   }
+  Displacements();
 }
 
 double WallContacts::FastDisplacement(int w) const {
@@ -171,11 +163,13 @@ double WallContacts::FastDisplacement(int w) const {
 
 void WallContacts::Displacements() {
   displacement_.assign(walls_.size(), 0.0);
-  for (size_t w = 0; w < walls_.size() && w < vertices_.size() && w < built_vertices_.size(); ++w) {
+  for (size_t w = 0; w < walls_.size(); ++w) {
     if (walls_[w].fast) {
       displacement_[w] = FastDisplacement(static_cast<int>(w));
       continue;
     }
+    if (w >= vertices_.size() || w >= built_vertices_.size() || built_vertices_[w].size() != vertices_[w].size())
+      continue;  // (not built yet)
     double m2 = 0.0;
     for (size_t k = 0; k < vertices_[w].size(); ++k)
       m2 = std::max(m2, (vertices_[w][k] - built_vertices_[w][k]).squaredNorm());
@@ -235,14 +229,19 @@ void WallContacts::SlotCandidates(const Vector3d& x, std::vector<int>* out) cons
 void WallContacts::Build(const ParticleStore& ps, int threads, double particle_displacement) {
   const int n = ps.slots();
   UpdateVertices(true);
-  built_vertices_ = vertices_;
-  displacement_.assign(walls_.size(), 0.0);
+  // where the walls are at the build: a slow wall's vertices, a fast wall's pose (FastDisplacement)
+  built_vertices_.resize(walls_.size());
   built_position_.resize(walls_.size());
   built_rotation_.resize(walls_.size());
   for (size_t w = 0; w < walls_.size(); ++w) {
+    if (walls_[w].fast)
+      built_vertices_[w].clear();
+    else
+      built_vertices_[w].assign(vertices_[w].begin(), vertices_[w].end());
     built_position_[w] = walls_[w].position;
     built_rotation_[w] = walls_[w].rotation;
   }
+  displacement_.assign(walls_.size(), 0.0);
   built_particle_displacement_ = particle_displacement;
   // each triangle's world box, grown by its wall's reach: the cheap test before the distance
   const int T = static_cast<int>(tris_.size());
@@ -367,10 +366,7 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
       const auto& face = wl.mesh.faces[tris_[tt].face];
       Vector3d q;
       if (wl.fast) {
-        const std::vector<Vector3d>& mv = wl.mesh.vertices;
-        const Vector3d v0 = wl.position + wl.rotation * mv[face[0]], v1 = wl.position + wl.rotation * mv[face[1]],
-                       v2 = wl.position + wl.rotation * mv[face[2]];
-        q = ClosestPointOnTriangle(xi, v0, v1, v2);
+        q = ClosestPointOnTriangle(xi, WorldVertex(wl, face[0]), WorldVertex(wl, face[1]), WorldVertex(wl, face[2]));
       } else {
         const std::vector<Vector3d>& wv = vertices_[w];
         q = ClosestPointOnTriangle(xi, wv[face[0]], wv[face[1]], wv[face[2]]);
@@ -492,7 +488,7 @@ void WallContacts::Io(Ar& ar) {
     for (size_t w = 0; w < vertices_.size(); ++w)
       if (vertices_[w].size() != walls_[w].mesh.vertices.size()) ar.Fail("a wall's vertices do not match its mesh");
     for (size_t w = 0; w < built_vertices_.size(); ++w)
-      if (built_vertices_[w].size() != walls_[w].mesh.vertices.size())
+      if (built_vertices_[w].size() != (walls_[w].fast ? 0 : walls_[w].mesh.vertices.size()))
         ar.Fail("a wall's vertices at its build do not match its mesh");
     if ((!built_position_.empty() && built_position_.size() != walls_.size()) ||
         built_rotation_.size() != built_position_.size())

@@ -90,10 +90,9 @@ class WallContacts {
   void ClearSlot(int s);
   /// Follows the store's permutation (new slot s holds old slot order[s]).
   void PermuteSlots(const std::vector<int>& order);
-  /// The slow walls' world vertices from their present poses, and each wall's largest vertex
-  /// distance from the wall build (WallDisplacement) in the same pass; a fast wall's distance is
-  /// bounded from its pose (FastDisplacement) and its vertices are taken where a contact needs them
-  /// (`all`: every wall's vertices, as a build needs).
+  /// The slow walls' world vertices from their present poses (`all`: every wall's, as a build
+  /// needs; a fast wall's are taken where a contact needs them), then each wall's displacement
+  /// from the wall build (Displacements).
   void UpdateVertices(bool all = false);
   /// Whether the candidates may miss a contact once the particles have moved up to
   /// `particle_displacement` from x_built.
@@ -157,7 +156,7 @@ class WallContacts {
     double power = 0.0, normal = 0.0;
     int contacts = 0;
   };
-  /// displacement_ from vertices_ and built_vertices_, and from the poses (after a checkpoint is read).
+  /// displacement_: a slow wall's from vertices_ and built_vertices_, a fast wall's from its pose.
   void Displacements();
   /// A bound on the distance of any vertex of fast wall w from where it was at the build, from the
   /// rigid motion since: |p - p_b| + ||R - R_b||_F max|v| (v in the body frame), plus the round-off.
@@ -187,7 +186,8 @@ class WallContacts {
   std::vector<int> count_;                        ///< per slot at a build: its number of candidates
   std::vector<DemWall> walls_;
   std::vector<SoilContactLaw> law_;  ///< the soil law with each wall's friction
-  std::vector<std::vector<Eigen::Vector3d>> vertices_, built_vertices_;  ///< world, now and at the build
+  /// world: now (a fast wall's as of its build) and, for a slow wall, at the build
+  std::vector<std::vector<Eigen::Vector3d>> vertices_, built_vertices_;
   std::vector<double> displacement_;  ///< per wall: its largest vertex distance between the two
   std::vector<double> radius_;        ///< per wall: its largest vertex distance from the body origin
   std::vector<Eigen::Vector3d> built_position_;  ///< per wall: its pose at the build
