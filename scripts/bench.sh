@@ -14,6 +14,7 @@
 #                                       about 20 min, paper hours: see the soil_scene section below)
 #   ./scripts/bench.sh doe_map          the time to map a 22 km x 22 km region (1101 x 1101 cells) from a finished table
 source "$(dirname "$0")/lib.sh"
+DM_CORE_BENCH=ON  # (build_core: the benchmark programs too)
 want="${1:-all}"
 case "$want" in all|vehicle_step|cosim_exchange|road_scene|dem_step|wheel_soil|soil_scene|doe_map) ;; *)
   echo "unknown benchmark '$want' (have: vehicle_step cosim_exchange road_scene dem_step wheel_soil soil_scene doe_map)" >&2; exit 2 ;;

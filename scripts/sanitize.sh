@@ -41,7 +41,8 @@ case "${1:-}" in
 esac
 san="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 say "build: clang, ASan + UBSan + libFuzzer in $dir (${tests[*]:-} fuzz_*)"
-cmake -S "$DM_ROOT" -B "$dir" -DCMAKE_CXX_COMPILER=clang++ -DDM_BUILD_ROS=OFF -DDM_BUILD_BENCH=OFF -DDM_BUILD_FUZZ=ON \
+ninja_folder "$dir"
+cmake -G Ninja -S "$DM_ROOT" -B "$dir" -DCMAKE_CXX_COMPILER=clang++ -DDM_BUILD_ROS=OFF -DDM_BUILD_BENCH=OFF -DDM_BUILD_FUZZ=ON \
   -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -gline-tables-only $san -fsanitize=fuzzer-no-link" \
   -DCMAKE_EXE_LINKER_FLAGS_SANITIZE="-fsanitize=address,undefined" >/dev/null
 targets=(fuzz_seeds)
@@ -49,16 +50,23 @@ for t in "${fuzz_targets[@]}"; do targets+=("fuzz_$t"); done
 cmake --build "$dir" -j"$(nproc)" --target "${tests[@]}" "${targets[@]}" dm_run_scene
 export ASAN_OPTIONS=detect_leaks=1:halt_on_error=1:abort_on_error=0
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
-failed=()
+# The test programs and the harnesses run as many at a time as there are cores (each is one
+# process on one core; one after the other they left a core idle for a minute at the end of the
+# test command), each into its log; their reports follow in a fixed order once all have ended.
+status="$dir/status"
+rm -rf "$status"; mkdir -p "$status"
+pool() {  # pool NAME COMMAND...: runs the command in the background once a core is free
+  while [ "$(jobs -rp | wc -l)" -ge "$(nproc)" ]; do wait -n || true; done
+  ( "${@:2}" && echo 0 >"$status/$1" || echo 1 >"$status/$1" ) &
+}
+run_test() {
+  local filter=()
+  [ "$1" = config_test ] && filter=(--gtest_filter=-Config.RunnerInterrupted*:Config.RunnerOnAFullDisk*:Config.RunnerStopped*)
+  cd "$dir/test/core" && "./$1" "${filter[@]}" >"$dir/$1.log" 2>&1
+}
 for t in "${tests[@]}"; do
   say "sanitize: $t"
-  filter=()
-  [ "$t" = config_test ] && filter=(--gtest_filter=-Config.RunnerInterrupted*:Config.RunnerOnAFullDisk*:Config.RunnerStopped*)
-  if ! (cd "$dir/test/core" && "./$t" "${filter[@]}" >"$dir/$t.log" 2>&1); then
-    failed+=("$t")
-    grep -E "ERROR: AddressSanitizer|runtime error|LeakSanitizer|FAILED" "$dir/$t.log" | head -20 || true
-    echo "(log: $dir/$t.log)"
-  fi
+  pool "$t" run_test "$t"
 done
 
 # the fuzzers: the shipped files as seeds, a corpus of their own per run (the quick run starts afresh
@@ -67,29 +75,52 @@ fuzz="$dir/fuzz"
 rm -rf "$fuzz/seeds"
 "$dir/test/fuzz/fuzz_seeds" "$fuzz/seeds" >/dev/null
 fuzz_flags=(-max_len=16384 -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=1024 -print_final_stats=1)
-for t in "${fuzz_targets[@]}"; do
-  [ -z "$fuzz_only" ] || [ "$t" = "$fuzz_only" ] || continue
-  bin="$dir/test/fuzz/fuzz_$t"
-  log="$dir/fuzz_$t.log"
-  regressions=("$DM_ROOT/test/fuzz/regressions/$t"/*)
+run_fuzz() {  # run_fuzz TARGET: its regression inputs once (their log: fuzz_TARGET.regressions.log), then its run
+  local t="$1" bin="$dir/test/fuzz/fuzz_$1" log="$dir/fuzz_$1.log" run
+  local regressions=("$DM_ROOT/test/fuzz/regressions/$t"/*)
   if [ -e "${regressions[0]}" ]; then
-    say "fuzz: $t, its ${#regressions[@]} regression input(s)"
-    if ! "$bin" "${fuzz_flags[@]}" -artifact_prefix="$fuzz/$t-" "${regressions[@]}" >"$log" 2>&1; then
-      failed+=("fuzz_$t regressions"); tail -30 "$log"; continue
-    fi
+    "$bin" "${fuzz_flags[@]}" -artifact_prefix="$fuzz/$t-" "${regressions[@]}" >"$dir/fuzz_$t.regressions.log" 2>&1 \
+      || { echo regressions >"$status/fuzz_$t.what"; return 1; }
   fi
   if [ -n "$fuzz_only" ]; then
     mkdir -p "$fuzz/corpus/$t"
-    say "fuzz: $t for $fuzz_seconds s (corpus $fuzz/corpus/$t)"
     run=(-max_total_time="$fuzz_seconds" "$fuzz/corpus/$t" "$fuzz/seeds/$t")
   else
     rm -rf "$fuzz/corpus/quick_$t"; mkdir -p "$fuzz/corpus/quick_$t"
-    say "fuzz: $t, ${DM_FUZZ_RUNS:-2000} inputs"
     run=(-runs="${DM_FUZZ_RUNS:-2000}" -seed=1 "$fuzz/corpus/quick_$t" "$fuzz/seeds/$t")
   fi
-  if "$bin" "${fuzz_flags[@]}" -artifact_prefix="$fuzz/$t-" "${run[@]}" >"$log" 2>&1; then
+  "$bin" "${fuzz_flags[@]}" -artifact_prefix="$fuzz/$t-" "${run[@]}" >"$log" 2>&1
+}
+fuzzed=()
+for t in "${fuzz_targets[@]}"; do
+  [ -z "$fuzz_only" ] || [ "$t" = "$fuzz_only" ] || continue
+  fuzzed+=("$t")
+  regressions=("$DM_ROOT/test/fuzz/regressions/$t"/*)
+  n=0; [ ! -e "${regressions[0]}" ] || n=${#regressions[@]}
+  if [ -n "$fuzz_only" ]; then
+    say "fuzz: $t, its $n regression input(s), then for $fuzz_seconds s (corpus $fuzz/corpus/$t)"
+  else
+    say "fuzz: $t, its $n regression input(s), then ${DM_FUZZ_RUNS:-2000} inputs"
+  fi
+  pool "fuzz_$t" run_fuzz "$t"
+done
+wait
+
+failed=()
+for t in "${tests[@]}"; do
+  [ "$(cat "$status/$t")" = 0 ] && continue
+  failed+=("$t")
+  grep -E "ERROR: AddressSanitizer|runtime error|LeakSanitizer|FAILED" "$dir/$t.log" | head -20 || true
+  echo "(log: $dir/$t.log)"
+done
+for t in "${fuzzed[@]}"; do
+  log="$dir/fuzz_$t.log"
+  if [ "$(cat "$status/fuzz_$t")" = 0 ]; then
+    echo -n "fuzz $t: "
     grep -E "^stat::number_of_executed_units|^stat::peak_rss_mb|^#[0-9]+ *DONE" "$log" | tr '\n' ' ' || true
     echo
+  elif [ -f "$status/fuzz_$t.what" ]; then
+    failed+=("fuzz_$t regressions"); tail -30 "$dir/fuzz_$t.regressions.log"
   else
     failed+=("fuzz_$t")
     grep -E -A12 "ERROR: (AddressSanitizer|libFuzzer|LeakSanitizer)|runtime error|uncaught exception|terminate called" "$log" | head -40 || tail -30 "$log"

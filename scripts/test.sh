@@ -37,7 +37,7 @@ trap 'kill -- -"$ctest_pid" 2>/dev/null || true' EXIT
 build_catkin
 ros_env
 say "test: catkin tests (roslaunch-check, rostest)"
-(cd "$DM_WS" && catkin_make run_tests -j"$(nproc)" >"$DM_BUILD/run_tests.log" 2>&1) || true
+(cd "$DM_WS" && catkin_make --use-ninja run_tests -j"$(nproc)" >"$DM_BUILD/run_tests.log" 2>&1) || true
 if ! catkin_test_results --verbose "$DM_WS/build/test_results/dem_mobility"; then
   tail -60 "$DM_BUILD/run_tests.log"
   echo "catkin tests failed; full log: $DM_BUILD/run_tests.log"
