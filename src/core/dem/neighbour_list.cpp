@@ -139,8 +139,15 @@ void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
     out.clear();
     for (int i = lo; i < hi; ++i) {
       const size_t first = out.size();
-      ForEachSlotNear(CellOf(x[i]), [&](int j) {
-        if (j != i && Owns(i, j) && (x[i] - x[j]).squaredNorm() < cut2) out.push_back(j);
+      // the live slots are in cell order (slab-major: SortSlots), so Owns(i, j) is i < j here: the
+      // cells before i's own hold lower slots only, those after it higher ones only (half the
+      // candidates the 27 cells hold are passed by without a look; the same lists)
+      const Eigen::Vector3i c = CellOf(x[i]);
+      const long own = CellIndex(c);
+      ForEachCellNear(c, [&](long cell) {
+        if (cell < own) return;
+        for (int j = cell == own ? i + 1 : cell_start_[cell]; j < cell_start_[cell + 1]; ++j)
+          if ((x[i] - x[j]).squaredNorm() < cut2) out.push_back(j);
       });
       std::sort(out.begin() + static_cast<long>(first), out.end());
       end[i] = static_cast<int>(out.size() - first);  // the count, for now

@@ -70,17 +70,23 @@ class NeighbourList {
     return std::min(c[slab_axis_] / cells_per_slab_, static_cast<int>(slab_start_.size()) - 2);
   }
   bool Owns(int i, int j) const { return slab_of_[i] < slab_of_[j] || (slab_of_[i] == slab_of_[j] && i < j); }
-  /// Calls f(slot) for every slot the last build put in the 27 cells about cell c.
+  /// Calls f(cell index) for each of the 27 cells about cell c that lie in the grid.
   template <class F>
-  void ForEachSlotNear(const Eigen::Vector3i& c, F&& f) const {
+  void ForEachCellNear(const Eigen::Vector3i& c, F&& f) const {
     Eigen::Vector3i q;
     for (q.z() = c.z() - 1; q.z() <= c.z() + 1; ++q.z())
       for (q.y() = c.y() - 1; q.y() <= c.y() + 1; ++q.y())
         for (q.x() = c.x() - 1; q.x() <= c.x() + 1; ++q.x()) {
           if ((q.array() < 0).any() || (q.array() >= grid_dims_.array()).any()) continue;
-          const long cell = CellIndex(q);
-          for (int j = cell_start_[cell]; j < cell_start_[cell + 1]; ++j) f(j);
+          f(CellIndex(q));
         }
+  }
+  /// Calls f(slot) for every slot the last build put in the 27 cells about cell c.
+  template <class F>
+  void ForEachSlotNear(const Eigen::Vector3i& c, F&& f) const {
+    ForEachCellNear(c, [&](long cell) {
+      for (int j = cell_start_[cell]; j < cell_start_[cell + 1]; ++j) f(j);
+    });
   }
   std::vector<long> SetUpGrid(const ParticleStore& ps);
   std::vector<int> SortSlots(ParticleStore* ps, const std::vector<long>& cell);
