@@ -321,6 +321,72 @@ TEST(Dem, FastWallStrikesEveryParticleWithWallOnlyBuilds) {
   EXPECT_GT(fast.wall_builds, fast.neighbour_builds);
 }
 
+// A slow wall's candidates are the triangles within d / 2 + the skin of a particle (its default
+// margin): a particle touches a wall only within d / 2 of it, a slow wall that moves half the skin
+// rebuilds the neighbour lists and its candidates, and a wall-only build follows whenever the wall
+// and the particles together have moved more than the margin since the last one. A cohesive,
+// plastic bed in a box under a lid pressing down into it gets the same forces, bit for bit, every
+// step, as with the margin of before (cutoff - d / 2: six times the skin), from fewer candidates.
+TEST(Dem, ASlowWallsCandidatesWithinTheSkinGiveTheForcesOfAWideMargin) {
+  struct Run {
+    std::vector<Vector3d> x, v, lid, floor;
+    long candidates = 0, wall_builds = 0;
+  };
+  const SoilParams p = Nominal();
+  const double d = p.diameter;
+  auto run = [&](double margin) {
+    DemSystem s(p, DemSettings());
+    std::vector<DemWall> box = {MakeQuadWall("floor", {-d, -d, 0}, {8 * d, 0, 0}, {0, 8 * d, 0}),
+                                MakeQuadWall("left", {-d, -d, 0}, {0, 0, 6 * d}, {8 * d, 0, 0}),
+                                MakeQuadWall("front", {-d, -d, 0}, {0, 8 * d, 0}, {0, 0, 6 * d})};
+    const double top = 3.0 * d;  // the lattice's top particles' tops
+    DemWall lid = MakeQuadWall("lid", {-d, -d, 0}, {0, 8 * d, 0}, {8 * d, 0, 0});  // (facing down)
+    lid.position = Vector3d(0, 0, top + 0.02 * d);
+    const double speed = 0.5 * d;  // [m/s] down: 0.3 d into the bed in 0.6 s
+    lid.velocity = Vector3d(0, 0, -speed);
+    box.push_back(lid);
+    int w_lid = -1, w_floor = -1;
+    for (DemWall& w : box) {
+      w.margin = margin;
+      const int k = s.AddWall(w);
+      if (w.name == "lid") w_lid = k;
+      if (w.name == "floor") w_floor = k;
+    }
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j)
+        for (int k = 0; k < 3; ++k)
+          s.AddParticle(Vector3d((i + 0.5 + 0.02 * (j % 3)) * d, (j + 0.5) * d, (k + 0.5) * d));
+    const double dt = 0.5 * s.CriticalTimeStep().dt_crit;
+    s.Finalize(dt);
+    Run r;
+    for (int n = 0; n < static_cast<int>(0.6 / dt); ++n) {
+      s.mutable_wall(w_lid).position.z() -= speed * dt;
+      s.Step();
+      r.lid.push_back(s.wall(w_lid).force);
+      r.floor.push_back(s.wall(w_floor).force);
+      r.candidates = std::max(r.candidates, s.wall_candidates());
+    }
+    r.x = s.positions();
+    r.v = s.velocities();
+    r.wall_builds = s.wall_builds();
+    return r;
+  };
+  const Run skin = run(0.0), wide = run(0.6 * d);
+  std::printf("wall candidates (most at a build): %ld within the skin, %ld within 0.6 d; wall builds %ld and %ld; "
+              "the lid's last force %.1f N\n",
+              skin.candidates, wide.candidates, skin.wall_builds, wide.wall_builds, skin.lid.back().z());
+  EXPECT_GT(skin.lid.back().z(), 10.0 * p.Mass() * 9.81);  // it did press into the bed
+  EXPECT_LT(skin.candidates, wide.candidates);
+  for (size_t n = 0; n < skin.lid.size(); ++n) {
+    ASSERT_EQ(skin.lid[n], wide.lid[n]) << "step " << n;
+    ASSERT_EQ(skin.floor[n], wide.floor[n]) << "step " << n;
+  }
+  for (size_t i = 0; i < skin.x.size(); ++i) {
+    EXPECT_EQ(skin.x[i], wide.x[i]) << "particle " << i;
+    EXPECT_EQ(skin.v[i], wide.v[i]) << "particle " << i;
+  }
+}
+
 // A fast wall's displacement since its build (what decides its candidates' next build) is bounded
 // from its pose, |p - p_b| + ||R - R_b||_F max|v|, without its vertices: never below any vertex's
 // distance, whatever the motion; exact for a translation; for a turn by theta about an axis square

@@ -35,7 +35,7 @@ int WallContacts::Add(DemWall wall, const SoilParams& soil, int slots) {
   SoilParams wp = soil;
   wp.friction = wall.friction;
   law_.emplace_back(wp);
-  const double margin = wall.margin > 0.0 ? wall.margin : (wall.fast ? cutoff_ - diameter_ : cutoff_ - 0.5 * diameter_);
+  const double margin = wall.margin > 0.0 ? wall.margin : cutoff_ - diameter_;  // (the skin)
   margin_.push_back(margin);
   reach_.push_back(0.5 * diameter_ + margin);
   tri_begin_.push_back(static_cast<int>(tris_.size()));

@@ -2,7 +2,7 @@
 // triangles, one tangential history per slot and wall, and the walls' wrenches.
 //
 // Candidates: the triangles within d / 2 + margin of the particle at the wall build (the margin
-// is the wall's own: cutoff - d / 2 for a slow wall, the skin for a fast one). A particle touches a
+// is the wall's own; the skin by default). A particle touches a
 // triangle only within half a diameter of it, and a point of a rigid triangle moves no more than
 // its vertices, so the candidates stay complete while a wall's largest vertex displacement plus the
 // particles' largest displacement since the wall build stays below its margin. The candidates are
@@ -54,9 +54,11 @@ struct DemWall {
   /// (WallContacts::NeedsBuild). A slow one (container, lid, cone) moving half the skin rebuilds
   /// the particles' neighbour lists too, as a particle moving that far does.
   bool fast = false;
-  /// How far the wall and the particles may move between candidate builds [m]; <= 0: the default
-  /// (the skin, d * skin, for a fast wall; cutoff - d / 2 for a slow one). A smaller margin means
-  /// fewer candidates per particle and more builds.
+  /// How far the wall and the particles may move between candidate builds [m]; <= 0: the default,
+  /// the skin (d * skin: a static wall then needs no build of its own, the particles moving at most
+  /// the skin between builds). A smaller margin means fewer candidates per particle and more
+  /// builds. (A slow wall's default was cutoff - d / 2 until 2026-12-05: six times the skin, the
+  /// particles of two layers along a box's walls its candidates, for the same forces.)
   double margin = 0.0;
   // results of the last force evaluation
   Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< on the wall, world
