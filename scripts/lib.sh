@@ -60,6 +60,9 @@ ninja_folder() {
 # DM_CORE_BENCH=ON (scripts/bench.sh sets it; the tests and the main job do not need them).
 DM_CORE_BENCH="${DM_CORE_BENCH:-OFF}"
 build_core() {
+  case "$DM_CORE_BENCH" in ON|OFF) ;; *)
+    echo "scripts/lib.sh: DM_CORE_BENCH must be ON or OFF, not '$DM_CORE_BENCH'" >&2; exit 2 ;;
+  esac
   say "build: core (plain CMake, Ninja, Release) in $DM_BUILD/core"
   ninja_folder "$DM_BUILD/core"
   cmake -G Ninja -S "$DM_ROOT" -B "$DM_BUILD/core" -DDM_BUILD_ROS=OFF -DCMAKE_BUILD_TYPE=Release \
