@@ -331,13 +331,21 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
   Vector3d f(si.f[0], si.f[1], si.f[2]);
   double max_rep = si.max_repulsion, max_ten = si.max_tension, max_overlap = si.overlap;
   auto tri_at = [&](int t) -> const WallTri& { return tris_[fresh ? fresh_tris[t] : tri_of_slot_[t]]; };
-  int t = t_begin;
-  for (int w = 0; w < W; ++w) {
-    const size_t hw = static_cast<size_t>(i) * W + w;
-    if (t == t_end || tri_at(t).wall != w) {  // no triangle of this wall near
-      ClearHistory(hw);
-      continue;
-    }
+  // the walls with no triangle near (most of them: a particle is near one wall or two) only clear
+  // what an earlier contact left, walls [w0, w1) at once
+  const size_t base = static_cast<size_t>(i) * W;
+  auto clear = [&](int w0, int w1) {
+    unsigned char any = 0;  // (a look at the flags first: mostly none is set)
+    for (int w = w0; w < w1; ++w) any |= touching_[base + w];
+    if (any)
+      for (int w = w0; w < w1; ++w) ClearHistory(base + w);
+  };
+  int t = t_begin, cleared = 0;
+  while (t < t_end) {
+    const int w = tri_at(t).wall;
+    clear(cleared, w);
+    cleared = w + 1;
+    const size_t hw = base + w;
     const DemWall& wl = walls_[w];
     // the deepest candidate's overlap (0 while none overlaps) and its squared distance
     double best = 0.0, best_d2 = std::numeric_limits<double>::infinity();
@@ -409,6 +417,7 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
     sum[w].normal += fn.Total();
     ++sum[w].contacts;
   }
+  clear(cleared, W);
   si.f[0] = f.x();
   si.f[1] = f.y();
   si.f[2] = f.z();
