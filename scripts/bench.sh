@@ -8,6 +8,7 @@
 #                                       (each rate the best of DM_BENCH_REPEATS timings, default 3,
 #                                       1 and 2 threads or ranks alternated; ours and LAMMPS's alike)
 #   ./scripts/bench.sh wheel_soil       the single-wheel rig's DEM step, beside the same soil without the tire
+#                                       (each rate the best of DM_BENCH_REPEATS timings, default 3, alternated)
 #   ./scripts/bench.sh soil_scene       the vehicle on the moving soil patch per level: wall s per simulated s,
 #                                       and the coupled step's rate against the bare soil patch
 #                                       (levels: DM_SOIL_LEVELS, default tiny,coarse,paper; tiny and coarse
