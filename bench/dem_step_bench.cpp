@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_repeats.h"
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_system.h"
@@ -90,18 +91,6 @@ double TriadBandwidth(int threads) {
   return best;
 }
 
-// DM_BENCH_REPEATS (default 3): how many times each rate is timed
-int Repeats() {
-  const char* e = std::getenv("DM_BENCH_REPEATS");
-  if (!e) return 3;
-  char* end = nullptr;
-  const long r = std::strtol(e, &end, 10);
-  if (end == e || *end != '\0' || r < 1 || r > 100) {
-    std::fprintf(stderr, "dem_step_bench: DM_BENCH_REPEATS=%s must be a whole number from 1 to 100\n", e);
-    std::exit(2);
-  }
-  return static_cast<int>(r);
-}
 
 // The rates of `kernel` at 1 and 2 threads, alternated, the best of `repeats` timings each (this
 // VM's rates move by up to a third between runs minutes apart: the best is the least disturbed;
@@ -118,7 +107,7 @@ void BestRates(const DemSystem& s, int steps, int repeats, PairKernel kernel, Ti
 // The rates of the default (vector) kernel and of the scalar reference at 1 and 2 threads, the
 // rebuilds in the timed steps and the contacts at the end of the warm-up: the lines of one bed.
 void Report(const char* bed, const DemSystem& s, int steps) {
-  const int repeats = Repeats();
+  const int repeats = dem_mobility::bench::Repeats("dem_step_bench");
   DemSystem warm = s;
   for (int i = 0; i < 20; ++i) warm.Step();
   const DemContactSummary c = warm.ContactSummary();

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_repeats.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/scenes/single_wheel.h"
 
@@ -53,18 +54,6 @@ double BareRate(const SingleWheelRig& rig0, int threads, int steps, bool plastic
   for (int i = 0; i < steps; ++i) s.Step();
   return static_cast<double>(s.num_alive()) * steps / Seconds(t0);
 }
-// DM_BENCH_REPEATS (default 3): how many times each rate is timed
-int Repeats() {
-  const char* e = std::getenv("DM_BENCH_REPEATS");
-  if (!e) return 3;
-  char* end = nullptr;
-  const long r = std::strtol(e, &end, 10);
-  if (end == e || *end != '\0' || r < 1 || r > 100) {
-    std::fprintf(stderr, "wheel_soil_bench: DM_BENCH_REPEATS=%s must be a whole number from 1 to 100\n", e);
-    std::exit(2);
-  }
-  return static_cast<int>(r);
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -73,6 +62,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int steps = argc > 2 ? std::stoi(argv[2]) : 2000;
+  const int repeats = dem_mobility::bench::Repeats("wheel_soil_bench");  // (before the set-up: minutes)
   std::vector<std::string> overrides;
   for (int i = 3; i < argc; ++i) overrides.push_back(argv[i]);
   const SingleWheelParams p = SingleWheelParams::Read(YamlReader::LoadWithOverrides(argv[1], overrides));
@@ -92,7 +82,6 @@ int main(int argc, char** argv) {
   std::printf("wheel_soil setup_wall %.1f s\n", setup);
   std::fflush(stdout);
   double rig_rate[3] = {0, 0, 0}, bare_rate[3] = {0, 0, 0}, contacts = 0.0;
-  const int repeats = Repeats();
   for (int T : {1, 2}) {
     double unledgered = 0.0;
     for (int r = 0; r < repeats; ++r) {
