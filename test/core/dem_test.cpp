@@ -209,6 +209,48 @@ TEST(Dem, ParticleRestsOnATriangleFaceEdgeAndVertex) {
   }
 }
 
+// Particles resting on a floor under gravity tilted 10 deg (below the wall's friction angle,
+// atan 0.5) are held by their wall contacts' anchor springs alone. A particle far from them (falling
+// beside the floor), moved from one end of the row to the other, makes a neighbour build that renumbers every slot
+// (it goes from the first slot to the last and back), and the springs must follow their
+// particles through it (WallContacts::PermuteSlots). Each particle then stays where it was, and
+// the floor carries the weight's slope component (pushed down the slope, +x): had a build lost the springs, a particle would
+// slip until its spring took up m g sin(theta) again, by about m g sin(theta) / k_t.
+TEST(Dem, WallContactSpringsFollowTheirParticlesThroughABuild) {
+  SoilParams p = Nominal();
+  p.plasticity = false;
+  const double D = p.diameter, r = 0.5 * D, theta = 10.0 * M_PI / 180.0, L = 20 * 1.5 * D;
+  DemSystem s(p, DemSettings());
+  s.set_gravity(9.81 * Vector3d(std::sin(theta), 0, -std::cos(theta)));
+  s.AddWall(MakeQuadWall("floor", {-D, -D, 0}, {L + 2 * D, 0, 0}, {0, 2 * D, 0}));
+  const int sentinel = s.AddParticle(Vector3d(-0.3, 0, 0.5));
+  std::vector<int> row;
+  for (int k = 0; k < 20; ++k) row.push_back(s.AddParticle(Vector3d(k * 1.5 * D, 0, r - 0.2 * p.adhesion_depth * D)));
+  s.Finalize(1.5e-5);
+  for (int i = 0; i < 20000; ++i) s.Step();  // 0.3 s: at rest
+  const double weight = p.Mass() * 9.81;
+  std::vector<Vector3d> x0;
+  for (int id : row) {
+    x0.push_back(s.position(id));
+    ASSERT_LT(s.velocity(id).norm(), 1e-6);
+  }
+  ASSERT_NEAR(s.wall(0).force.x(), 20 * weight * std::sin(theta), 1e-6 * weight);
+  // what a lost spring would cost: the static stretch of one
+  const double slip = weight * std::sin(theta) / p.TangentialStiffness();
+  const long builds = s.neighbour_builds();
+  for (int k = 0; k < 6; ++k) {
+    s.mutable_position(sentinel) = Vector3d(k % 2 ? -0.3 : L + 0.3, 0, 0.5);
+    s.mutable_velocity(sentinel).setZero();
+    for (int i = 0; i < 200; ++i) s.Step();
+  }
+  EXPECT_GE(s.neighbour_builds() - builds, 6);
+  for (size_t k = 0; k < row.size(); ++k) {
+    EXPECT_LT((s.position(row[k]) - x0[k]).norm(), 1e-3 * slip) << k;
+    EXPECT_LT(s.velocity(row[k]).norm(), 1e-6) << k;
+  }
+  EXPECT_NEAR(s.wall(0).force.x(), 20 * weight * std::sin(theta), 1e-6 * weight);
+}
+
 // a few hundred particles poured into a box come to rest: slow (under 1e-3 m/s, with plasticity at
 // f = 0.05, 1 and 3 and without it), barely overlapping, the walls carrying the whole weight.
 DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* carried_fraction, double f = 1.0) {

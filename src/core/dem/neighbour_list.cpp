@@ -192,7 +192,9 @@ void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
 #pragma omp single
     {
       // the lists in slot order, each with room for slack_ more; in the old lists' place (grown
-      // without copying them when they are too small: they are not read any more)
+      // without copying them when they are too small: they are not read any more; with a sixteenth
+      // to spare, so that a bed being pressed together, its pairs growing a little at each build,
+      // does not take fresh pages at every build)
       for (int i = 0; i < n; ++i) {
         const int count = i < live ? end[i] : 0;
         begin[i] = total;
@@ -205,9 +207,10 @@ void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
         nbr_ = std::vector<int>();
         hist_ = std::vector<TangentialHistory>();
         touching_ = std::vector<unsigned char>();
-        ReserveOnHugePages(&nbr_, total);
-        ReserveOnHugePages(&hist_, total);
-        ReserveOnHugePages(&touching_, total);
+        const size_t room = static_cast<size_t>(total) + static_cast<size_t>(total) / 16;
+        ReserveOnHugePages(&nbr_, room);
+        ReserveOnHugePages(&hist_, room);
+        ReserveOnHugePages(&touching_, room);
       }
       nbr_.resize(total);
       hist_.resize(total);

@@ -136,8 +136,45 @@ void WallContacts::ClearSlot(int s) {
 }
 
 void WallContacts::PermuteSlots(const std::vector<int>& order) {
-  core::PermuteSlots(&hist_, order, walls_.size());
-  core::PermuteSlots(&touching_, order, walls_.size());
+  // Only a slot touching a wall has a history that is not zero (a contact's end clears it:
+  // ClearHistory; a checkpoint is checked for it, Io). So the slots with a contact are moved out
+  // and put back at their new slots, and the rest of the two arrays, zero, stays where it is: no
+  // pass over all of hist_ (slots x walls x 24 B, 150 MB at the paper level, at every build; a
+  // gather into a new array had the kernel zero that many fresh pages each time), and nothing
+  // allocated once the scratch has grown.
+  const size_t W = walls_.size();
+  if (W == 0) return;
+  const size_t n = touching_.size() / W;
+  moved_slot_.clear();
+  moved_hist_.clear();
+  moved_touching_.clear();
+  for (size_t o = 0; o < n; ++o) {
+    unsigned char* t = &touching_[o * W];
+    unsigned char any = 0;
+    for (size_t w = 0; w < W; ++w) any |= t[w];
+    if (!any) continue;
+    moved_slot_.push_back(static_cast<int>(o));
+    for (size_t w = 0; w < W; ++w) {
+      moved_touching_.push_back(t[w]);
+      if (!t[w]) continue;  // (its history is zero: only the walls it touches are read)
+      moved_hist_.push_back(hist_[o * W + w]);
+      t[w] = 0;
+      hist_[o * W + w] = TangentialHistory();
+    }
+  }
+  // each old slot's new one (the slots beyond the permutation's stay)
+  new_slot_.resize(n);
+  for (size_t s = 0; s < n; ++s) new_slot_[s] = static_cast<int>(s);
+  for (size_t s = 0; s < order.size(); ++s) new_slot_[order[s]] = static_cast<int>(s);
+  const TangentialHistory* h = moved_hist_.data();
+  for (size_t k = 0; k < moved_slot_.size(); ++k) {
+    const size_t s = static_cast<size_t>(new_slot_[moved_slot_[k]]);
+    for (size_t w = 0; w < W; ++w)
+      if (moved_touching_[k * W + w]) {
+        touching_[s * W + w] = moved_touching_[k * W + w];
+        hist_[s * W + w] = *h++;
+      }
+  }
 }
 
 void WallContacts::UpdateVertices(bool all) {
@@ -472,6 +509,7 @@ size_t WallContacts::MemoryBytes() const {
              bytes(built_rotation_);
   for (const Bins& bn : bins_) b += bytes(bn.start) + bytes(bn.faces);
   for (const std::vector<int>& c : chunk_tris_) b += bytes(c);
+  b += bytes(moved_slot_) + bytes(moved_hist_) + bytes(moved_touching_) + bytes(new_slot_);
   return b;
 }
 
@@ -511,6 +549,9 @@ void WallContacts::Io(Ar& ar) {
     if (!tri_lo_.empty() && (tri_lo_.size() != tris_.size() || tri_hi_.size() != tris_.size()))
       ar.Fail("the triangles' boxes do not match the triangles");
     if (!walls_.empty() && hist_.size() % walls_.size() != 0) ar.Fail("the wall histories do not match the walls");
+    for (size_t k = 0; k < hist_.size(); ++k)
+      if (!touching_[k] && !(hist_[k].spring.array() == 0.0).all())
+        ar.Fail("a wall history without its contact (the history of a wall the particle does not touch is zero)");
     for (size_t s = 0; s < tri_start_.size(); ++s)
       if (tri_start_[s] < 0 || tri_start_[s] > static_cast<int>(tri_of_slot_.size()) ||
           (s > 0 && tri_start_[s] < tri_start_[s - 1]))

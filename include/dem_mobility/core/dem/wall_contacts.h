@@ -200,6 +200,11 @@ class WallContacts {
   std::vector<int> tri_start_, tri_of_slot_;  ///< CSR: candidate triangles per slot, in wall order
   std::vector<TangentialHistory> hist_;       ///< per slot and wall
   std::vector<unsigned char> touching_;       ///< per slot and wall
+  // PermuteSlots' scratch (kept from build to build): the slots touching a wall, their rows of
+  // touching_ and the histories of the walls they touch, and each old slot's new one
+  std::vector<int> moved_slot_, new_slot_;
+  std::vector<TangentialHistory> moved_hist_;
+  std::vector<unsigned char> moved_touching_;
   std::vector<WallSum> chunk_;                ///< per chunk of slots and wall
 };
 
