@@ -1,6 +1,7 @@
 #include "dem_mobility/core/dem/neighbour_list.h"
 #include "dem_mobility/core/common/state_archive.h"
 
+#include <algorithm>
 #include <cmath>
 #include <omp.h>
 
@@ -151,6 +152,12 @@ void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
       }
     };
     const int a1 = (slab_axis_ + 1) % 3, a2 = (slab_axis_ + 2) % 3, s = slab_axis_;
+    // the cell of slot i: the live slots are sorted by cell, so the cells are walked along with
+    // the slots (cell_start_), each cell's coordinates worked out once, instead of from each slot's
+    // position (CellOf: the same cell, from the same position, as SetUpGrid sorted it by)
+    long cell = std::upper_bound(cell_start_.begin(), cell_start_.end(), lo) - cell_start_.begin() - 1;
+    Eigen::Vector3i c(0, 0, 0);
+    long c_of = -1;  // the cell c holds the coordinates of
     for (int i = lo; i < hi; ++i) {
       const size_t first = used;
       // the live slots are in cell order (slab-major: SortSlots), so Owns(i, j) is i < j here: the
@@ -159,7 +166,14 @@ void NeighbourList::ListPairs(const ParticleStore& ps, int threads) {
       // rest of i's own row of three (its own cell from i + 1 on) and the four whole rows after it
       // ((a2 + 1, s) and (a2 - 1..a2 + 1, s + 1)), in that order: ascending slots, so the list
       // comes out sorted (the same lists as a look at every cell and a sort)
-      const Eigen::Vector3i c = CellOf(x[i]);
+      while (cell_start_[cell + 1] <= i) ++cell;
+      if (cell != c_of) {
+        c_of = cell;
+        c[s] = static_cast<int>(cell / grid_stride_[s]);
+        const long in_slab = cell % grid_stride_[s];
+        c[a2] = static_cast<int>(in_slab / grid_stride_[a2]);
+        c[a1] = static_cast<int>(in_slab % grid_stride_[a2]);
+      }
       const int r0 = std::max(c[a1] - 1, 0), r1 = std::min(c[a1] + 1, grid_dims_[a1] - 1);
       auto row_end = [&](int q2, int qs) {
         return cell_start_[r1 + 1 + q2 * grid_stride_[a2] + static_cast<long>(qs) * grid_stride_[s]];
