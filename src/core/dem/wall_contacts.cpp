@@ -139,7 +139,7 @@ void WallContacts::PermuteSlots(const std::vector<int>& order) {
   // Only a slot touching a wall has a history that is not zero (a contact's end clears it:
   // ClearHistory; a checkpoint is checked for it, Io). So the slots with a contact are moved out
   // and put back at their new slots, and the rest of the two arrays, zero, stays where it is: no
-  // pass over all of hist_ (slots x walls x 24 B, 150 MB at the paper level, at every build; a
+  // pass over all of hist_ (slots x walls x 24 B, 181 MB at the paper level, at every build; a
   // gather into a new array had the kernel zero that many fresh pages each time), and nothing
   // allocated once the scratch has grown.
   const size_t W = walls_.size();
