@@ -91,7 +91,6 @@ double TriadBandwidth(int threads) {
   return best;
 }
 
-
 // The rates of `kernel` at 1 and 2 threads, alternated, the best of `repeats` timings each (this
 // VM's rates move by up to a third between runs minutes apart: the best is the least disturbed;
 // bench.sh times LAMMPS the same way)
