@@ -5,8 +5,11 @@
 #include "dem_mobility/core/dem/pair_sweep.h"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <thread>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/dem/dem_energy.h"
@@ -16,6 +19,55 @@ namespace dem_mobility::core {
 using Eigen::Vector3d;
 
 namespace {
+
+// ---------------------------------------------------------------------------------------------
+// the slabs' schedule
+
+// Runs sweep(slab) on every slab, on `threads` threads, with each particle's sums added in the
+// order of the two colours one after the other (every even slab, then every odd one), but without
+// the barrier between them. A slab writes to its own particles and the next slab's, so an odd slab
+// shares particles with the even slabs beside it only: it must run after both, and may run beside
+// any other slab. The threads take the slabs in a fixed order, the even ones ascending, each odd
+// slab o right after the even slab o + 1 + 2 threads (or at the end): by the time a thread takes
+// an odd slab, the even slabs it waits for were taken 2 threads slabs earlier and are (nearly
+// always) done. A thread waits only for those two, not for the other thread's last slab of a
+// colour. Slabs never depend on the thread count (neighbour_list.h): the same sums for any.
+template <class Sweep>
+void SweepSlabs(int ns, int threads, const Sweep& sweep) {
+  constexpr int kMaxSlabs = 64;  // (NeighbourList::SetUpSlabs makes at most 64)
+  DM_DEMAND(ns <= kMaxSlabs);
+  std::array<int, kMaxSlabs> order;
+  std::array<std::atomic<int>, kMaxSlabs> done;
+  const int lag = 1 + 2 * threads;
+  int m = 0, next_odd = 1;
+  for (int e = 0; e < ns; e += 2) {
+    order[m++] = e;
+    if (e - lag >= next_odd) {
+      order[m++] = next_odd;
+      next_odd += 2;
+    }
+  }
+  for (; next_odd < ns; next_odd += 2) order[m++] = next_odd;
+  for (int s = 0; s < ns; ++s) done[s].store(0, std::memory_order_relaxed);
+  std::atomic<int> next{0};
+  auto ready = [&](int s) { return s < 0 || s >= ns || done[s].load(std::memory_order_acquire) != 0; };
+#pragma omp parallel num_threads(threads)
+  for (int k = next.fetch_add(1, std::memory_order_relaxed); k < ns; k = next.fetch_add(1, std::memory_order_relaxed)) {
+    const int sl = order[k];
+    if (sl % 2 == 1)
+      for (int spins = 0; !(ready(sl - 1) && ready(sl + 1)); ++spins) {
+        if (spins < 1 << 14) {
+#if defined(__x86_64__) || defined(__i386__)
+          __builtin_ia32_pause();
+#endif
+        } else {
+          std::this_thread::yield();  // (the other thread may not be running: more threads than cores)
+        }
+      }
+    sweep(sl);
+    done[sl].store(1, std::memory_order_release);
+  }
+}
 
 // ---------------------------------------------------------------------------------------------
 // the scalar reference: the soil law's per-pair functions, one contact after the other
@@ -88,15 +140,11 @@ void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int thre
     si.overlap = max_overlap;
   };
   const std::vector<SlotState>& state = ps->state;
-  const int ns = lists->num_slabs();
-  for (int colour = 0; colour < 2; ++colour) {
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int sl = colour; sl < ns; sl += 2) {
-      for (int i = lists->slab_start(sl); i < lists->slab_start(sl + 1); ++i)
-        if (state[i] == SlotState::kListed) sweep(i);
-      for (const int i : lists->slab_added(sl)) sweep(i);
-    }
-  }
+  SweepSlabs(lists->num_slabs(), threads, [&](int sl) {
+    for (int i = lists->slab_start(sl); i < lists->slab_start(sl + 1); ++i)
+      if (state[i] == SlotState::kListed) sweep(i);
+    for (const int i : lists->slab_added(sl)) sweep(i);
+  });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -420,12 +468,9 @@ void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, 
                       lists->histories().data(),
                       lists->touching().data()};
   const SlotState* state = ps->state.data();
-  const int ns = lists->num_slabs();
-  for (int colour = 0; colour < 2; ++colour) {
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int sl = colour; sl < ns; sl += 2)
-      slab(c, a, state, lists->slab_start(sl), lists->slab_start(sl + 1), lists->slab_added(sl));
-  }
+  SweepSlabs(lists->num_slabs(), threads, [&](int sl) {
+    slab(c, a, state, lists->slab_start(sl), lists->slab_start(sl + 1), lists->slab_added(sl));
+  });
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -4,8 +4,9 @@
 //
 // Ownership and slabs: a pair belongs to the particle in the lower slab (or, in the same slab, the
 // lower slot), so a slab's pairs write only to its own and the next slab's particles; the pair
-// sweep runs the even slabs in parallel, then the odd ones. Slabs are at least one cutoff thick and
-// depend on the particles only, not on the thread count.
+// sweep runs the even slabs in parallel, then the odd ones (each odd slab once the even slabs beside
+// it are done: pair_sweep.cpp's SweepSlabs). Slabs are at least one cutoff thick and depend on the
+// particles only, not on the thread count.
 //
 // A build sorts the particle slots by slab and cell (returns the permutation, for other per-slot
 // data) and lists each live slot's partners within the cutoff, ascending, with `list_slack` spare

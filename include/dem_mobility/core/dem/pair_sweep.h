@@ -1,7 +1,8 @@
 // The DEM pair forces: every listed pair evaluated once, its force added to both particles. The
-// slabs are swept by colour, the even slabs in parallel and then the odd ones (see
-// neighbour_list.h), each slab by one thread in ascending slot order: every particle's force is
-// summed in the same order for any number of threads.
+// slabs are swept as if by colour, the even slabs in parallel and then the odd ones (see
+// neighbour_list.h; each odd slab in fact waits only for the two even slabs beside it), each slab
+// by one thread in ascending slot order: every particle's force is summed in the same order for any
+// number of threads.
 //
 // Two kernels compute the same law:
 //  - the scalar one, the soil law's per-pair functions (SoilContactLaw::Normal, Tangential) one
