@@ -8,7 +8,9 @@
 // Per bed: the rates of the default pair kernel (the vector one, on the best instruction set the CPU
 // has) and of the scalar reference (1 and 2 threads alternated, the best of DM_BENCH_REPEATS
 // timings each, default 3), the neighbour builds in the timed steps, and the contacts'
-// mean normal force and its parts (so that a reader sees what work the bed does).
+// mean normal force and its parts (so that a reader sees what work the bed does); and the roofline
+// of the step's two streaming passes (they alone on a copy of the bed's particles: their rates,
+// their bandwidth beside the triad's, their share of the step, and the rest's scaling).
 //   dem_step_bench [SOIL.yaml] [steps] [BED_B_SCENE.yaml | none]
 #include <algorithm>
 #include <chrono>
@@ -21,6 +23,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_system.h"
+#include "dem_mobility/core/dem/dem_watchdogs.h"
 #include "dem_mobility/core/scenes/dem_pour.h"
 
 using namespace dem_mobility::core;
@@ -91,6 +94,69 @@ double TriadBandwidth(int threads) {
   return best;
 }
 
+// The step's two streaming passes alone: DemSystem::Step without the force evaluation between
+// them, `steps` times on a copy of the bed's particle arrays, on `threads` threads. The drift, the
+// state watchdog and the hot records packed; then the sums unpacked and started again, the overlap
+// watchdog, the second half kick and the plastic update's inputs read (its law left out: a few
+// flops and a table lookup). The same store methods on the same arrays as the step's own passes,
+// so the same memory traffic; particle-steps per second. (Without the sweep, f is the weight at
+// every step: the particles fall freely, far less than the watchdog's half skin in these steps.)
+volatile double g_streaming_sink = 0.0;
+double StreamingRate(const DemSystem& s, int threads, int steps) {
+  ParticleStore ps = s.particles();
+  ps.SizeScratch();
+  const int n = ps.slots();
+  const double dt = s.dt(), h = 0.5 * dt, inv_m = 1.0 / s.mass();
+  const double half_skin = 0.05 * s.soil().diameter, overlap_limit = 0.5 * s.soil().diameter;
+  const Vector3d weight = s.mass() * s.gravity();
+  for (int i = 0; i < n; ++i) ps.PackFresh(i, ps.live(i) ? weight : Vector3d::Zero());
+  double check = 0.0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int step = 0; step < steps; ++step) {
+    double max_disp2 = 0.0, sum = 0.0;
+    int tripped = n;
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(max : max_disp2) reduction(min : tripped)
+    for (int i = 0; i < n; ++i) {
+      if (!ps.live(i)) continue;
+      if (!ps.held[i]) {
+        ps.v[i] += h * inv_m * ps.f[i];
+        ps.x[i] += dt * ps.v[i];
+        max_disp2 = std::max(max_disp2, (ps.x[i] - ps.x_built[i]).squaredNorm());
+      }
+      if (StateTrips(ps, i, dt, half_skin)) tripped = std::min(tripped, i);
+      ps.PackHot(i);
+    }
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(min : tripped) reduction(+ : sum)
+    for (int i = 0; i < n; ++i) {
+      ps.Unpack(i);
+      if (!ps.live(i)) {
+        ps.StartSums(i, Vector3d::Zero());
+        continue;
+      }
+      ps.StartSums(i, weight);
+      if (OverlapTrips(ps, i, overlap_limit)) tripped = std::min(tripped, i);
+      if (!ps.held[i]) ps.v[i] += h * inv_m * ps.f[i];
+      sum += ps.plastic[i] * ps.max_repulsion[i] + ps.adhesion_max[i] * ps.max_tension[i];
+    }
+    check += max_disp2 + sum + tripped;
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  g_streaming_sink = check;
+  return static_cast<double>(s.num_alive()) * steps / wall;
+}
+
+// The bytes those two passes move per particle, counted as STREAM counts them (each array a pass
+// reads once, each it writes once; the write-allocate reads not counted): the drift reads x, v, f,
+// x_built, the state, the held flag, the plastic deformation and the adhesion, and writes x, v and
+// the hot record; the unpack reads the sums, the state, the held flag, v, the plastic deformation
+// and the adhesion, and writes f, the three maxima, the sums and v.
+constexpr int kDriftBytes = 4 * sizeof(Vector3d) + sizeof(SlotState) + sizeof(unsigned char) + 2 * sizeof(double) +
+                            2 * sizeof(Vector3d) + sizeof(HotParticle);
+constexpr int kUnpackBytes = sizeof(PairSums) + sizeof(SlotState) + sizeof(unsigned char) + sizeof(Vector3d) +
+                             2 * sizeof(double) + sizeof(Vector3d) + 3 * sizeof(double) + sizeof(PairSums) +
+                             sizeof(Vector3d);
+constexpr int kStreamingBytes = kDriftBytes + kUnpackBytes;
+
 // The rates of `kernel` at 1 and 2 threads, alternated, the best of `repeats` timings each (this
 // VM's rates move by up to a third between runs minutes apart: the best is the least disturbed;
 // bench.sh times LAMMPS the same way)
@@ -135,6 +201,27 @@ void Report(const char* bed, const DemSystem& s, int steps) {
     std::printf("dem_step %s_vector_over_scalar_2threads %.3f x\n", bed, v2.rate / s2.rate);
   }
   std::printf("dem_step %s_bytes_per_particle %.0f B\n", bed, static_cast<double>(s.MemoryBytes()) / s.num_alive());
+  std::fflush(stdout);
+  // the roofline of the step's streaming passes: they alone, at 1 and 2 threads (alternated, the
+  // best of the repeats), their bandwidth beside the triad's, and what is left of the step without them
+  double p1 = 0.0, p2 = 0.0;
+  for (int r = 0; r < repeats; ++r) {
+    p1 = std::max(p1, StreamingRate(s, 1, steps));
+    p2 = std::max(p2, StreamingRate(s, 2, steps));
+  }
+  std::printf("# dem_step %s_streaming: the step's two passes over the particles alone (no forces), %d steps, best of %d\n", bed, steps, repeats);
+  std::printf("dem_step %s_streaming_rate_1thread %.3f Mparticle-steps/s\n", bed, p1 * 1e-6);
+  std::printf("dem_step %s_streaming_rate_2threads %.3f Mparticle-steps/s\n", bed, p2 * 1e-6);
+  std::printf("dem_step %s_streaming_speedup_1_to_2 %.3f x\n", bed, p2 / p1);
+  std::printf("dem_step %s_streaming_bytes_per_particle_step %d B\n", bed, kStreamingBytes);
+  std::printf("dem_step %s_streaming_bandwidth_1thread %.1f GB/s\n", bed, p1 * kStreamingBytes * 1e-9);
+  std::printf("dem_step %s_streaming_bandwidth_2threads %.1f GB/s\n", bed, p2 * kStreamingBytes * 1e-9);
+  std::printf("# dem_step %s_streaming_share: the passes' time over the whole step's, at each thread count\n", bed);
+  std::printf("dem_step %s_streaming_share_1thread %.3f ratio\n", bed, v1.rate / p1);
+  std::printf("dem_step %s_streaming_share_2threads %.3f ratio\n", bed, v2.rate / p2);
+  // the rest of the step (the sweep, the walls, the builds): its time at 1 thread over its time at 2
+  const double rest1 = 1.0 / v1.rate - 1.0 / p1, rest2 = 1.0 / v2.rate - 1.0 / p2;
+  if (rest1 > 0.0 && rest2 > 0.0) std::printf("dem_step %s_rest_speedup_1_to_2 %.3f x\n", bed, rest1 / rest2);
   std::fflush(stdout);
 }
 }  // namespace

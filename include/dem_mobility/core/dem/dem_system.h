@@ -139,6 +139,8 @@ class DemSystem {
   /// Wall candidate triangles over all particles at the last wall build.
   long wall_candidates() const { return walls_.candidates(); }
   const WallContacts& wall_contacts() const { return walls_; }
+  /// The particles' per-slot arrays (read only; the benchmarks copy them).
+  const ParticleStore& particles() const { return ps_; }
   /// Of those, the builds forced by an added particle whose neighbour's list had no room left.
   long overflow_builds() const { return overflow_builds_; }
   int contacts() const { return lists_.contacts(); }  ///< pairs in contact at the last force evaluation
