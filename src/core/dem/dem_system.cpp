@@ -191,6 +191,8 @@ void DemSystem::Step() {
   const Vector3d weight = mass_ * gravity_;
   double max_disp2 = 0.0;
   int tripped = n;  // the lowest slot a watchdog trips on
+  // (bench/dem_step_bench.cpp's StreamingRate runs this pass and the last one alone, for the
+  // roofline: what changes the arrays they read or write changes it too)
   // the drift, each slot then packed for the force evaluation (while it is in the cache: one
   // pass over the particles fewer; a neighbour build below permutes the slots and packs them again).
   // The sums were started by the last step's final pass unless something changed the slots since
