@@ -23,8 +23,8 @@
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/cosim/cosim_loop.h"
-#include "dem_mobility/core/mobility/mobility_scene.h"
+#include "dem_mobility/core/mobility/cosim_loop.h"
+#include "dem_mobility/core/mobility/mobility_run.h"
 #include "dem_mobility/core/terrain/dem_soil.h"
 #include "dem_mobility/core/terrain/soil_patch.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
@@ -35,6 +35,100 @@ namespace {
 double Seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
+
+/// Times two windows of the whole coupled step in one run, each against the bare soil in the same
+/// state: 0.2 s into the drive (the wheels rolling, the patch in place, nothing emitted yet), and
+/// once the patch has followed the vehicle for `follow` s (the emitter laying soil ahead, the
+/// leveling tools moving: what most of a run's simulated time is). It sees every step of the run
+/// (the vehicle's steps, the soil's every exchange, the driver): a window's wall time is that of
+/// its steps; the bare soil is timed at the window's end, between two steps of the run, which then
+/// goes on.
+struct Windows final : public CoSimObserver {
+  const DemSoilTerrain* soil = nullptr;
+  const SoilPatch* patch = nullptr;
+  std::string level;
+  int n = 0;
+  long window_steps = 0;
+  double follow = 0.0, following_since = -1.0, ratio = 0.0;
+  int done = 0;  // windows finished
+  int wanted = 2;  // windows to time
+  long at = -1;  // the step the window in progress began at (-1: none)
+  long soil0 = 0, nb0 = 0, wb0 = 0, re0 = 0;
+  double t_begin = 0.0;
+  std::chrono::steady_clock::time_point t0;
+  void OnStep(const VehicleCoSim& s, const DriverCommand&) override {
+    const DemSystem& dem = soil->bin().dem();
+    if (patch && patch->stats().following && following_since < 0.0) following_since = s.time();
+    if (at < 0) {
+      Begin(s, dem);
+      return;
+    }
+    if (s.step() - at >= window_steps) Finish(s, dem);
+  }
+  /// Begins a window when its time has come.
+  void Begin(const VehicleCoSim& s, const DemSystem& dem) {
+    const bool begin = done == 0 ? s.driver_time() >= 0.2
+                                 : following_since >= 0.0 && s.time() - following_since >= follow;
+    if (!begin) return;
+    at = s.step();
+    t_begin = s.time();
+    soil0 = dem.step_count();
+    nb0 = dem.neighbour_builds();
+    wb0 = dem.wall_builds();
+    re0 = patch ? patch->stats().reemitted : 0;
+    t0 = std::chrono::steady_clock::now();
+  }
+  /// Ends the window: the bare soil timed over as many steps, the window's lines printed.
+  void Finish(const VehicleCoSim& s, const DemSystem& dem) {
+    const double coupled = Seconds(t0);
+    const long soil_steps = dem.step_count() - soil0;
+    const long nb = dem.neighbour_builds() - nb0, wb = dem.wall_builds() - wb0;
+    const long reemitted = patch ? patch->stats().reemitted - re0 : 0;
+    // the bare soil: a copy of the soil now, the tires and tools lifted 10 m and stopped
+    DemSystem bare(dem);
+    for (int w = 0; w < soil->bin().wheels(); ++w) {
+      DemWall& t = bare.mutable_wall(soil->bin().tire_wall(w));
+      t.position.z() += 10.0;
+      t.velocity.setZero();
+      t.angular_velocity.setZero();
+    }
+    for (int w : {soil->bin().leveling_cylinder(), soil->bin().leveling_plate()}) {
+      if (w < 0) continue;
+      bare.mutable_wall(w).position.z() += 10.0;
+      bare.mutable_wall(w).velocity.setZero();
+    }
+    const long bnb0 = bare.neighbour_builds(), bwb0 = bare.wall_builds();
+    const auto tb = std::chrono::steady_clock::now();
+    for (long k = 0; k < soil_steps; ++k) bare.Step();
+    const double bare_wall = Seconds(tb);
+    const double sim_time = s.time() - t_begin;
+    const double r = bare_wall / coupled;  // (n soil_steps / coupled) / (n soil_steps / bare)
+    // (a one-window level's lines are its first window's, untagged: a '#' line says so)
+    const std::string tag = done == 0 && wanted == 2 ? "_before_following" : "";
+    const char *lv = level.c_str(), *tg = tag.c_str();
+    std::printf("# soil_scene %s_window%s: t = %.3f-%.3f s, speed %.2f m/s, %ld soil steps%s\n", lv, tg, t_begin,
+                s.time(), s.vehicle().ForwardSpeed(), soil_steps,
+                wanted == 1 ? " (the only window of this level: 0.2 s into the drive, before the patch follows)" : "");
+    std::printf("soil_scene %s_window%s %.4f s\n", lv, tg, sim_time);
+    std::printf("soil_scene %s_reemitted%s %ld count\n", lv, tg, reemitted);
+    std::printf("soil_scene %s_neighbour_rebuilds%s %ld count\n", lv, tg, nb);
+    std::printf("soil_scene %s_wall_rebuilds%s %ld count\n", lv, tg, wb);
+    std::printf("soil_scene %s_bare_soil_neighbour_rebuilds%s %ld count\n", lv, tg, bare.neighbour_builds() - bnb0);
+    std::printf("soil_scene %s_bare_soil_wall_rebuilds%s %ld count\n", lv, tg, bare.wall_builds() - bwb0);
+    std::printf("soil_scene %s_coupled_rate%s %.3f Mparticle-steps/s\n", lv, tg, 1e-6 * n * soil_steps / coupled);
+    std::printf("soil_scene %s_bare_soil_rate%s %.3f Mparticle-steps/s\n", lv, tg, 1e-6 * n * soil_steps / bare_wall);
+    std::printf("soil_scene %s_rate_ratio%s %.3f ratio\n", lv, tg, r);
+    std::printf("soil_scene %s_wall_s_per_sim_s%s %.1f s\n", lv, tg, coupled / sim_time);
+    std::printf("soil_scene %s_wall_us_per_soil_step%s %.1f us\n", lv, tg, 1e6 * coupled / soil_steps);
+    std::fflush(stdout);
+    ratio = r;
+    wall_per_sim = coupled / sim_time;
+    ++done;
+    at = -1;
+  }
+  bool StopRequested() override { return done == wanted; }
+  double wall_per_sim = 0.0;
+};
 
 }  // namespace
 
@@ -97,96 +191,12 @@ int main(int argc, char** argv) {
       std::printf("soil_scene %s_soil_critical_time_step %.3g s\n", level.c_str(), dem0.CriticalTimeStep().dt_crit);
       std::printf("soil_scene %s_prepare_wall %.1f s\n", level.c_str(), prepare);
       std::fflush(stdout);
-      // two windows of the whole coupled step in one run, each against the bare soil in the
-      // same state: 0.2 s into the drive (the wheels rolling, the patch in place, nothing emitted
-      // yet), and once the patch has followed the vehicle for `follow` s (the emitter laying soil
-      // ahead, the leveling tools moving: what most of a run's simulated time is). The observer
-      // sees every step of the run (the vehicle's steps, the soil's every exchange, the driver):
-      // a window's wall time is that of its steps; the bare soil is timed at the window's end,
-      // between two steps of the run, which then goes on.
+      // the windows of the whole coupled step (Windows)
       MobilityRun run(p, std::move(terrain));
       const VehicleCoSim& sim = run.sim();
       const SoilPatch* patch = soil->patch();
       const long window_steps = std::max(1L, std::lround(window / sim.dt()));
-      struct Windows final : public CoSimObserver {
-        const DemSoilTerrain* soil = nullptr;
-        const SoilPatch* patch = nullptr;
-        std::string level;
-        int n = 0;
-        long window_steps = 0;
-        double follow = 0.0, following_since = -1.0, ratio = 0.0;
-        int done = 0;  // windows finished
-        int wanted = 2;  // windows to time
-        long at = -1;  // the step the window in progress began at (-1: none)
-        long soil0 = 0, nb0 = 0, wb0 = 0, re0 = 0;
-        double t_begin = 0.0;
-        std::chrono::steady_clock::time_point t0;
-        void OnStep(const VehicleCoSim& s, const DriverCommand&) override {
-          const DemSystem& dem = soil->bin().dem();
-          if (patch && patch->stats().following && following_since < 0.0) following_since = s.time();
-          if (at < 0) {
-            const bool begin = done == 0 ? s.driver_time() >= 0.2
-                                         : following_since >= 0.0 && s.time() - following_since >= follow;
-            if (!begin) return;
-            at = s.step();
-            t_begin = s.time();
-            soil0 = dem.step_count();
-            nb0 = dem.neighbour_builds();
-            wb0 = dem.wall_builds();
-            re0 = patch ? patch->stats().reemitted : 0;
-            t0 = std::chrono::steady_clock::now();
-            return;
-          }
-          if (s.step() - at < window_steps) return;
-          const double coupled = Seconds(t0);
-          const long soil_steps = dem.step_count() - soil0;
-          const long nb = dem.neighbour_builds() - nb0, wb = dem.wall_builds() - wb0;
-          const long reemitted = patch ? patch->stats().reemitted - re0 : 0;
-          // the bare soil: a copy of the soil now, the tires and tools lifted 10 m and stopped
-          DemSystem bare(dem);
-          for (int w = 0; w < soil->bin().wheels(); ++w) {
-            DemWall& t = bare.mutable_wall(soil->bin().tire_wall(w));
-            t.position.z() += 10.0;
-            t.velocity.setZero();
-            t.angular_velocity.setZero();
-          }
-          for (int w : {soil->bin().leveling_cylinder(), soil->bin().leveling_plate()}) {
-            if (w < 0) continue;
-            bare.mutable_wall(w).position.z() += 10.0;
-            bare.mutable_wall(w).velocity.setZero();
-          }
-          const long bnb0 = bare.neighbour_builds(), bwb0 = bare.wall_builds();
-          const auto tb = std::chrono::steady_clock::now();
-          for (long k = 0; k < soil_steps; ++k) bare.Step();
-          const double bare_wall = Seconds(tb);
-          const double sim_time = s.time() - t_begin;
-          const double r = bare_wall / coupled;  // (n soil_steps / coupled) / (n soil_steps / bare)
-          // (a one-window level's lines are its first window's, untagged: a '#' line says so)
-          const std::string tag = done == 0 && wanted == 2 ? "_before_following" : "";
-          const char *lv = level.c_str(), *tg = tag.c_str();
-          std::printf("# soil_scene %s_window%s: t = %.3f-%.3f s, speed %.2f m/s, %ld soil steps%s\n", lv, tg, t_begin,
-                      s.time(), s.vehicle().ForwardSpeed(), soil_steps,
-                      wanted == 1 ? " (the only window of this level: 0.2 s into the drive, before the patch follows)" : "");
-          std::printf("soil_scene %s_window%s %.4f s\n", lv, tg, sim_time);
-          std::printf("soil_scene %s_reemitted%s %ld count\n", lv, tg, reemitted);
-          std::printf("soil_scene %s_neighbour_rebuilds%s %ld count\n", lv, tg, nb);
-          std::printf("soil_scene %s_wall_rebuilds%s %ld count\n", lv, tg, wb);
-          std::printf("soil_scene %s_bare_soil_neighbour_rebuilds%s %ld count\n", lv, tg, bare.neighbour_builds() - bnb0);
-          std::printf("soil_scene %s_bare_soil_wall_rebuilds%s %ld count\n", lv, tg, bare.wall_builds() - bwb0);
-          std::printf("soil_scene %s_coupled_rate%s %.3f Mparticle-steps/s\n", lv, tg, 1e-6 * n * soil_steps / coupled);
-          std::printf("soil_scene %s_bare_soil_rate%s %.3f Mparticle-steps/s\n", lv, tg, 1e-6 * n * soil_steps / bare_wall);
-          std::printf("soil_scene %s_rate_ratio%s %.3f ratio\n", lv, tg, r);
-          std::printf("soil_scene %s_wall_s_per_sim_s%s %.1f s\n", lv, tg, coupled / sim_time);
-          std::printf("soil_scene %s_wall_us_per_soil_step%s %.1f us\n", lv, tg, 1e6 * coupled / soil_steps);
-          std::fflush(stdout);
-          ratio = r;
-          wall_per_sim = coupled / sim_time;
-          ++done;
-          at = -1;
-        }
-        bool StopRequested() override { return done == wanted; }
-        double wall_per_sim = 0.0;
-      } windows;
+      Windows windows;
       windows.soil = soil;
       windows.patch = patch;
       windows.level = level;

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/mobility/mobility_scene.h"
+#include "dem_mobility/core/mobility/mobility_run.h"
 
 using namespace dem_mobility::core;
 

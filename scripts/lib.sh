@@ -8,7 +8,7 @@ DM_WS="${DM_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/dem_mobility/ws-$(printf %s "$DM
 # Debian's python3 (catkin_pkg, rosbag) before any pyenv/venv python on PATH
 export PATH="/usr/bin:$PATH"
 
-DM_CORE_PACKAGES=(cmake ninja-build make g++ libeigen3-dev libyaml-cpp-dev libgtest-dev libbenchmark-dev)
+DM_CORE_PACKAGES=(cmake ninja-build make g++ libeigen3-dev libyaml-cpp-dev libgtest-dev libbenchmark-dev universal-ctags)
 DM_ROS_PACKAGES=(catkin ros-core-dev rosbash libroscpp-dev libnodeletlib-dev librosbag-dev libtf2-ros-dev
   libtf2-eigen-dev libnodeletlib-tools ros-geometry-msgs ros-sensor-msgs ros-visualization-msgs ros-message-generation
   ros-nav-msgs python3-nav-msgs python3-tf2-msgs ros-rosgraph-msgs ros-tf2-msgs libtopic-tools-dev pluginlib-dev

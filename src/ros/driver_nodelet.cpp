@@ -5,7 +5,7 @@
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 
-#include "dem_mobility/core/cosim/ports.h"
+#include "dem_mobility/core/mobility/ports.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 #include "dem_mobility/ros/conversions.h"
 #include "dem_mobility/ros/core_names.h"

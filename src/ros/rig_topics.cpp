@@ -193,9 +193,9 @@ class WheelTopics final : public RigTopics {
     m.error = f.error();
     m.scene = p.file;
     m.fidelity = p.bin.level.name;
-    m.cohesion_factor = p.bin.cohesion_factor;
+    m.cohesion_factor = p.bin.strength.cohesion_factor;
     m.friction = p.bin.friction;
-    m.cone_index_psi = p.bin.ConeIndex();
+    m.cone_index_psi = p.bin.strength.ConeIndex();
     m.drive = SingleWheelParams::DriveName(p.drive);
     m.slip_commanded = p.drive == SingleWheelParams::Drive::kSlip ? p.slip : nan;
     m.torque_commanded = p.drive == SingleWheelParams::Drive::kTorque ? p.torque : nan;

@@ -24,7 +24,7 @@
 #include "dem_mobility/TerrainReport.h"
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
-#include "dem_mobility/core/cosim/vehicle_cosim.h"
+#include "dem_mobility/core/mobility/vehicle_cosim.h"
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
@@ -60,6 +60,7 @@ class TerrainNodelet : public nodelet::Nodelet {
       timing = LoadExchangeTiming(pnh, &transport);
       Param(pnh, "frame_id", &frame_id_);
       RateParam(pnh, "cloud_rate", &cloud_rate_);
+      Param(pnh, "prepared_soil_cache", &prepared_soil_cache_);
     } catch (const std::exception& e) {
       Refuse(transport, e.what());
       return;
@@ -78,10 +79,8 @@ class TerrainNodelet : public nodelet::Nodelet {
                const ExchangeTiming& timing) {
     std::unique_ptr<ExchangeServer<WheelStates, WheelWrenches>> server;
     try {
-      const TerrainDescription d = DescribeTerrain(scene.terrain_file, scene.terrain_overrides);
-      if (d.time_step > 0.0)
-        NODELET_INFO("terrain '%s' from %s (level '%s'): preparing ...", d.model.c_str(), scene.terrain_file.c_str(),
-                     d.fidelity.c_str());
+      // (the file is read once, by LoadTerrainModel: a DEM soil's progress lines say what it prepares)
+      NODELET_INFO("terrain from %s: loading ...", scene.terrain_file.c_str());
       const auto t0 = std::chrono::steady_clock::now();
       // a shutdown (SIGINT, SIGTERM, the manager unloading this nodelet) stops the preparation
       // within a step: the exchange is then closed with the reason, so the vehicle's wait ends
@@ -91,6 +90,7 @@ class TerrainNodelet : public nodelet::Nodelet {
         NODELET_INFO("terrain: preparing the soil: %s", at.Line().c_str());
       };
       hooks.progress_every = 30.0;
+      hooks.prepared_soil_cache = prepared_soil_cache_;
       std::unique_ptr<TerrainModel> model =
           LoadTerrainModel(scene.terrain_file, TerrainVehicleOf(VehicleSpec::Load(scene.vehicle_file)),
                            scene.terrain_overrides, hooks);
@@ -339,6 +339,7 @@ class TerrainNodelet : public nodelet::Nodelet {
   ros::Publisher markers_, cloud_, tools_;
   ros::ServiceServer report_;
   std::string frame_id_ = "odom", exchange_name_;
+  std::string prepared_soil_cache_;  ///< ~prepared_soil_cache: the folder of prepared soils ("" none)
   double cloud_rate_ = 10.0, next_frame_ = 0.0, time_ = 0.0, surface_z_ = 0.0;
   std::vector<float> first_shown_;  ///< each particle's plastic strain when first shown (by ID)
   std::vector<WheelState> states_;

@@ -25,7 +25,7 @@
 #include "dem_mobility/TerrainReport.h"
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
-#include "dem_mobility/core/cosim/cosim_loop.h"
+#include "dem_mobility/core/mobility/cosim_loop.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/ros/conversions.h"
 #include "dem_mobility/ros/vehicle_visuals.h"
@@ -248,8 +248,6 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
         interrupted_why_ = e.what();
         try {
           r.terrain = DescribeTerrain(scene_.terrain_file, scene_.terrain_overrides);
-          r.terrain_model = r.terrain.model;
-          r.cone_index = r.terrain.cone_index;
         } catch (const std::exception&) {
         }
       } else {
@@ -341,8 +339,8 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
     m.scene = scene_.file;
     m.kind = scene_.kind;
     m.grade_deg = scene_.grade_deg;
-    m.cone_index_psi = r.cone_index;
-    m.terrain_model = r.terrain_model;
+    m.cone_index_psi = r.terrain.cone_index;
+    m.terrain_model = r.terrain.model;
     m.fidelity = r.terrain.fidelity;
     // the level's error estimate, as the terrain reports it in the result file: a number, or a
     // text saying it was not measured

@@ -22,8 +22,8 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/mobility/mobility_scene.h"
-#include "dem_mobility/core/scenes/scene_registry.h"
+#include "dem_mobility/core/mobility/mobility_run.h"
+#include "dem_mobility/tools/scene_runners.h"
 
 using namespace dem_mobility::core;
 
@@ -34,6 +34,7 @@ extern "C" void OnSignal(int) { g_stop.store(true); }
 int Usage(std::ostream& os, int status) {
   os << "usage: dm_run_scene SCENE.yaml [key=value ...] [--out RESULT.yaml] [--history HISTORY.csv] [--quiet]\n"
         "                   [--checkpoint FILE [--checkpoint-every SECONDS]] [--restart FILE]\n"
+        "                   [--prepared-soil-cache DIR]\n"
         "       dm_run_scene SCENE.yaml [key=value ...] --check\n"
         "       dm_run_scene --checkpoint-info CHECKPOINT\n"
         "       dm_run_scene --help\n"
@@ -47,6 +48,9 @@ int Usage(std::ostream& os, int status) {
         "                     SIGTERM; kept after an error or an interrupt, removed once the run has ended)\n"
         "  --restart FILE     mobility runs: takes the run up from that checkpoint, bit for bit as if it had\n"
         "                     never stopped; the same scene, overrides, input files and build are required\n"
+        "  --prepared-soil-cache DIR  soils prepared before by this build from the same files are read from\n"
+        "                     DIR instead of prepared again, and a soil prepared here is kept there\n"
+        "                     (default: the environment's DM_SOIL_CACHE; none when unset or empty)\n"
         "  dm_run_scene --checkpoint-info FILE   what a checkpoint holds: its scene, overrides, time, and\n"
         "                     whether this build wrote it and its input files are unchanged\n"
         "  --check            reads and checks the scene and every file it names (vehicle, terrain, soil,\n"
@@ -86,6 +90,8 @@ int main(int argc, char** argv) {
   // a file size limit (ulimit -f) fails a write with an error instead of killing the process, so
   // that the result says what failed
   std::signal(SIGXFSZ, SIG_IGN);
+  // the test command and a user's shell name a folder of prepared soils once for every run
+  if (const char* cache = std::getenv("DM_SOIL_CACHE")) options.prepared_soil_cache = cache;
   std::vector<std::string> overrides;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -94,6 +100,7 @@ int main(int argc, char** argv) {
     else if (a == "--quiet") options.quiet = true;
     else if (a == "--checkpoint" && i + 1 < argc) options.checkpoint_file = argv[++i];
     else if (a == "--restart" && i + 1 < argc) options.restart_file = argv[++i];
+    else if (a == "--prepared-soil-cache" && i + 1 < argc) options.prepared_soil_cache = argv[++i];
     else if (a == "--checkpoint-every" && i + 1 < argc) {
       const std::string v = argv[++i];
       char* end = nullptr;

@@ -13,7 +13,7 @@
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_shapes.h"
-#include "dem_mobility/core/scenes/calibration.h"
+#include "dem_mobility/core/soil/calibration.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
 #include "dem_mobility/core/scenes/uniaxial_compression.h"
 
@@ -62,11 +62,11 @@ TEST(ConeConfig, ConeIndexTurnsIntoFThroughTheTable) {
                                                    base.friction);
   const double ci = 0.5 * (cal.ci.front() + cal.ci.back());
   const ConeParams p = Cone({"cone_index=" + std::to_string(ci)});
-  EXPECT_DOUBLE_EQ(p.cohesion_factor, cal.CohesionFactor(ci));
-  EXPECT_DOUBLE_EQ(p.soil.cohesion_factor, p.cohesion_factor);
-  EXPECT_DOUBLE_EQ(p.requested_ci, ci);
-  ASSERT_TRUE(p.calibration.has_value());
-  EXPECT_EQ(p.calibration->file, cal.file);
+  EXPECT_DOUBLE_EQ(p.strength.cohesion_factor, cal.CohesionFactor(ci));
+  EXPECT_DOUBLE_EQ(p.soil.cohesion_factor, p.strength.cohesion_factor);
+  EXPECT_DOUBLE_EQ(p.strength.requested_ci, ci);
+  ASSERT_TRUE(p.strength.calibration);
+  EXPECT_EQ(p.strength.calibration->file, cal.file);
   // the result says which table it used, for which particles, and the table's error
   const std::string text = ConeResultFile(ConeResult(), p).Text();
   for (const char* key : {"calibration_table:", "calibration_level:", "calibration_particle_diameter:",
@@ -74,7 +74,7 @@ TEST(ConeConfig, ConeIndexTurnsIntoFThroughTheTable) {
     EXPECT_NE(text.find(key), std::string::npos) << key << " not in:\n" << text;
   EXPECT_NE(text.find(cal.file), std::string::npos);
   // without cone_index no table is used, and the result names none
-  EXPECT_FALSE(Cone({"cohesion_factor=2"}).calibration.has_value());
+  EXPECT_FALSE(Cone({"cohesion_factor=2"}).strength.calibration);
 }
 
 // A level whose particles no table was made for: the cone index is refused, naming the key and

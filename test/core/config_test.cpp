@@ -16,7 +16,7 @@
 #include "dem_mobility/core/common/input_files.h"
 #include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/mobility/mobility_run.h"
+#include "dem_mobility/core/mobility/mobility_result.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
 #include "dem_mobility/core/terrain/dem_soil.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
@@ -303,13 +303,13 @@ TEST(Config, AnOverriddenSoilStrengthTakesThePlaceOfTheFilesOther) {
   auto read = [&](const std::vector<std::string>& o) { return DemSoilParams::Read(YamlReader::LoadWithOverrides(patch, o)); };
   // the file's CI 100 through the coarse table (the row [100, 7.5962])
   const DemSoilParams file = read({});
-  EXPECT_DOUBLE_EQ(file.requested_ci, 100.0);
-  EXPECT_NEAR(file.cohesion_factor, 7.5962, 1e-9);
+  EXPECT_DOUBLE_EQ(file.strength.requested_ci, 100.0);
+  EXPECT_NEAR(file.strength.cohesion_factor, 7.5962, 1e-9);
   // f 3 by an override: f 3, no requested CI; CI 50 by an override: the table's f (2.5953)
   const DemSoilParams f3 = read({"cohesion_factor=3"});
-  EXPECT_DOUBLE_EQ(f3.cohesion_factor, 3.0);
-  EXPECT_TRUE(std::isnan(f3.requested_ci));
-  EXPECT_NEAR(read({"cone_index=50"}).cohesion_factor, 2.5953, 1e-9);
+  EXPECT_DOUBLE_EQ(f3.strength.cohesion_factor, 3.0);
+  EXPECT_TRUE(std::isnan(f3.strength.requested_ci));
+  EXPECT_NEAR(read({"cone_index=50"}).strength.cohesion_factor, 2.5953, 1e-9);
   // both by overrides: refused
   try {
     read({"cohesion_factor=3", "cone_index=50"});
@@ -321,8 +321,8 @@ TEST(Config, AnOverriddenSoilStrengthTakesThePlaceOfTheFilesOther) {
   // the cone scene's file gives f 1: a cone index override takes its place (coarse table, CI 50)
   const std::string cone = DM_CONFIG_DIR "/scenes/cone_penetrometer.yaml";
   const ConeParams c = ConeParams::Read(YamlReader::LoadWithOverrides(cone, {"fidelity=coarse", "cone_index=50"}));
-  EXPECT_NEAR(c.cohesion_factor, 2.5953, 1e-9);
-  EXPECT_DOUBLE_EQ(ConeParams::Read(YamlReader::LoadWithOverrides(cone, {"fidelity=coarse"})).cohesion_factor, 1.0);
+  EXPECT_NEAR(c.strength.cohesion_factor, 2.5953, 1e-9);
+  EXPECT_DOUBLE_EQ(ConeParams::Read(YamlReader::LoadWithOverrides(cone, {"fidelity=coarse"})).strength.cohesion_factor, 1.0);
   // both in the file: refused (a copy of the patch's file with f added, its paths made absolute)
   const std::string dir = ::testing::TempDir() + "/both_strengths";
   std::filesystem::create_directories(dir);

@@ -22,9 +22,9 @@
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/cosim/cosim_loop.h"
-#include "dem_mobility/core/mobility/mobility_scene.h"
-#include "dem_mobility/core/scenes/soil_prep.h"
+#include "dem_mobility/core/mobility/cosim_loop.h"
+#include "dem_mobility/core/mobility/mobility_run.h"
+#include "dem_mobility/core/soil/soil_prep.h"
 #include "dem_mobility/core/terrain/dem_soil.h"
 #include "dem_mobility/core/terrain/soil_patch.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
@@ -73,6 +73,15 @@ DemSoilParams TinySoil(double ci, double length = 0.0) {
   return p;
 }
 
+/// Soils prepared by LoadTerrainModel are kept in, and read back from, the folder the test command
+/// names (DM_SOIL_CACHE, scripts/test.sh): one preparation per soil for the whole suite.
+PreparationHooks SuiteSoilCache() {
+  PreparationHooks h;
+  const char* dir = std::getenv("DM_SOIL_CACHE");
+  if (dir) h.prepared_soil_cache = dir;
+  return h;
+}
+
 /// One prepared patch per soil and box length for the whole binary; each test takes a copy.
 std::unique_ptr<DemSoilTerrain> PreparedPatch(double ci, double length = 0.0) {
   static std::map<std::pair<double, double>, std::unique_ptr<DemSoilTerrain>> prepared;
@@ -94,7 +103,8 @@ std::unique_ptr<DemSoilTerrain> PreparedStrips(double ci) {
     std::unique_ptr<TerrainModel> m = LoadTerrainModel(
         kTerrain, TerrainVehicleOf(Hmmwv()),
         {"fidelity=tiny", "threads=1", "cone_index=" + std::to_string(ci), "track_strip_width=0.9",
-         "levels.tiny.length=" + std::to_string(kShortBox), "patch.check_window=[0.3, 0.7]"});
+         "levels.tiny.length=" + std::to_string(kShortBox), "patch.check_window=[0.3, 0.7]"},
+        SuiteSoilCache());
     t.reset(dynamic_cast<DemSoilTerrain*>(m.release()));
     if (!t) throw std::runtime_error("soil_patch.yaml: not a dem_soil terrain");
   }
@@ -513,7 +523,7 @@ TEST(TrackStrips, PoursSoilUnderTheTracksOnlyCarriesTheVehicleAndReEmitsIt) {
   const TerrainVehicle vehicle = TerrainVehicleOf(Hmmwv());
   const double w = 0.9, c = 0.5 * vehicle.track;
   std::unique_ptr<TerrainModel> m = LoadTerrainModel(
-      kTerrain, vehicle, {"fidelity=tiny", "threads=1", "cone_index=100", "track_strip_width=0.9"});
+      kTerrain, vehicle, {"fidelity=tiny", "threads=1", "cone_index=100", "track_strip_width=0.9"}, SuiteSoilCache());
   auto* t = dynamic_cast<DemSoilTerrain*>(m.get());
   ASSERT_NE(t, nullptr);
   const DemSoilParams& p = t->bin().params();
@@ -658,7 +668,7 @@ TEST(VehicleOnSoil, RefusesBadInputNamingFileAndKey) {
 // A run on the moving soil patch stopped at a checkpoint and taken up again from the file is, bit
 // for bit, the run that never stopped: the particles and their contact histories, the walls' and
 // tires' candidates, the patch's sphere, emitter and random generator, the vehicle and the driver
-// all go on where they were (mobility/mobility_scene.h).
+// all go on where they were (mobility/mobility_run.h).
 TEST(Checkpoint, ASoilRunTakenUpAgainIsTheRunThatNeverStopped) {
   // PreparedStrips(100)'s soil, as the scene's terrain overrides; the vehicle arrives at 6 m/s, so
   // the patch starts to follow and re-emits soil before and after the checkpoint
@@ -756,20 +766,18 @@ TEST(Checkpoint, ASoilRunTakenUpAgainIsTheRunThatNeverStopped) {
   }
 }
 
-// With DM_SOIL_CACHE a prepared soil is kept and read back instead of prepared again: bit for bit
+// With a prepared-soil cache a prepared soil is kept and read back instead of prepared again: bit for bit
 // the soil the preparation gives (the runs on both go on alike); a damaged file is prepared again.
 // (Strips 0.5 m wide, five particles: only the keeping and the reading back are checked here.)
 TEST(Checkpoint, APreparedSoilIsKeptAndReadBackBitForBit) {
   const std::string dir = ::testing::TempDir() + "dm_soil_cache_test";
   std::filesystem::remove_all(dir);
-  const char* was = std::getenv("DM_SOIL_CACHE");
-  const std::string before = was ? was : "";
-  ::setenv("DM_SOIL_CACHE", dir.c_str(), 1);
   const TerrainVehicle vehicle = TerrainVehicleOf(Hmmwv());
   const std::vector<std::string> o = {"fidelity=tiny", "threads=1", "cone_index=80", "track_strip_width=0.5",
                                       "levels.tiny.length=" + std::to_string(kShortBox),
                                       "patch.check_window=[0.3, 0.7]"};
-  const auto load = [&](const PreparationHooks& hooks = {}) {
+  const auto load = [&](PreparationHooks hooks = {}) {
+    hooks.prepared_soil_cache = dir;
     std::unique_ptr<TerrainModel> m = LoadTerrainModel(kTerrain, vehicle, o, hooks);
     std::unique_ptr<DemSoilTerrain> t(dynamic_cast<DemSoilTerrain*>(m.release()));
     if (!t) throw std::runtime_error("not a dem_soil terrain");
@@ -838,10 +846,6 @@ TEST(Checkpoint, APreparedSoilIsKeptAndReadBackBitForBit) {
   EXPECT_EQ(told.size(), in_order.size());
   EXPECT_EQ(phases_told(), in_order);
   EXPECT_EQ(load()->prepared_from(), files[0]);
-  if (was)
-    ::setenv("DM_SOIL_CACHE", before.c_str(), 1);
-  else
-    ::unsetenv("DM_SOIL_CACHE");
 }
 
 }  // namespace

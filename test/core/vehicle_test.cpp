@@ -10,7 +10,7 @@
 #include <string>
 
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/mobility/mobility_scene.h"
+#include "dem_mobility/core/mobility/mobility_run.h"
 #include "dem_mobility/core/vehicle/vehicle.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 

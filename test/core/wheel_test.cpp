@@ -285,9 +285,9 @@ TEST(SingleWheelConfig, UsesTheCalibrationTableOfItsParticleSizeOnly) {
   // coarse (0.06 m): the table made at 0.06 m turns CI into f and is named in the result
   const SingleWheelParams coarse =
       SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"fidelity=coarse", "cone_index=100"}));
-  ASSERT_TRUE(coarse.bin.calibration);
-  EXPECT_DOUBLE_EQ(coarse.bin.calibration->particle_diameter, 0.06);
-  EXPECT_DOUBLE_EQ(coarse.bin.cohesion_factor, coarse.bin.calibration->CohesionFactor(100.0));
+  ASSERT_TRUE(coarse.bin.strength.calibration);
+  EXPECT_DOUBLE_EQ(coarse.bin.strength.calibration->particle_diameter, 0.06);
+  EXPECT_DOUBLE_EQ(coarse.bin.strength.cohesion_factor, coarse.bin.strength.calibration->CohesionFactor(100.0));
   ResultFile r(SceneFile(), "single_wheel");
   coarse.bin.Describe(&r);
   EXPECT_NE(r.Text().find("calibration_table"), std::string::npos);
@@ -295,16 +295,16 @@ TEST(SingleWheelConfig, UsesTheCalibrationTableOfItsParticleSizeOnly) {
   // tiny (0.1 m): the table made at 0.1 m (level tiny_cal of the cone scene)
   const SingleWheelParams tiny =
       SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"fidelity=tiny", "cone_index=100"}));
-  ASSERT_TRUE(tiny.bin.calibration);
-  EXPECT_DOUBLE_EQ(tiny.bin.calibration->particle_diameter, 0.1);
-  EXPECT_DOUBLE_EQ(tiny.bin.cohesion_factor, tiny.bin.calibration->CohesionFactor(100.0));
+  ASSERT_TRUE(tiny.bin.strength.calibration);
+  EXPECT_DOUBLE_EQ(tiny.bin.strength.calibration->particle_diameter, 0.1);
+  EXPECT_DOUBLE_EQ(tiny.bin.strength.cohesion_factor, tiny.bin.strength.calibration->CohesionFactor(100.0));
   // medium (0.05 m): no table is made at that size; a cone index is refused, f runs with its CI unknown
   ExpectRefused({"fidelity=medium", "cone_index=100"}, "particle_diameter");
   const SingleWheelParams medium =
       SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"fidelity=medium", "cohesion_factor=2"}));
-  EXPECT_FALSE(medium.bin.calibration);
-  EXPECT_FALSE(std::isfinite(medium.bin.ConeIndex()));
-  EXPECT_NE(medium.bin.no_table_reason.find("0.05"), std::string::npos) << medium.bin.no_table_reason;
+  EXPECT_FALSE(medium.bin.strength.calibration);
+  EXPECT_FALSE(std::isfinite(medium.bin.strength.ConeIndex()));
+  EXPECT_NE(medium.bin.strength.no_table_reason.find("0.05"), std::string::npos) << medium.bin.strength.no_table_reason;
 }
 
 TEST(SingleWheelRig, ALoadTheSoilCannotCarryIsReportedSunk) {

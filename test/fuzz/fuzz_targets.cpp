@@ -9,8 +9,8 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/soil_law.h"
-#include "dem_mobility/core/scenes/calibration.h"
-#include "dem_mobility/core/scenes/scene_registry.h"
+#include "dem_mobility/core/soil/calibration.h"
+#include "dem_mobility/tools/scene_runners.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 

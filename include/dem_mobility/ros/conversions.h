@@ -12,9 +12,9 @@
 #include "dem_mobility/WheelStates.h"
 #include "dem_mobility/WheelWrenches.h"
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/cosim/exchange.h"
+#include "dem_mobility/core/common/exchange.h"
 #include "dem_mobility/core/vehicle/driver.h"
-#include "dem_mobility/core/mobility/mobility_run.h"
+#include "dem_mobility/core/mobility/mobility_result.h"
 #include "dem_mobility/ros/lockstep.h"
 #include "dem_mobility/ros/core_names.h"
 

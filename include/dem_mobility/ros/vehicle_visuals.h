@@ -9,7 +9,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "dem_mobility/core/cosim/vehicle_cosim.h"
+#include "dem_mobility/core/mobility/vehicle_cosim.h"
 #include "dem_mobility/ros/core_names.h"
 
 namespace dem_mobility {

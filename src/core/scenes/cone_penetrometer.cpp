@@ -7,7 +7,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_shapes.h"
-#include "dem_mobility/core/scenes/soil_prep.h"
+#include "dem_mobility/core/soil/soil_prep.h"
 
 namespace dem_mobility::core {
 
@@ -15,8 +15,6 @@ using Eigen::Vector2d;
 using Eigen::Vector3d;
 
 namespace {
-
-constexpr double kMinCohesionFactor = 0.05, kMaxCohesionFactor = 12.0;  // the paper's range
 
 ConeLevel ReadLevel(const YamlReader& y, const std::string& name) {
   ConeLevel l;
@@ -48,30 +46,12 @@ ConeParams ConeParams::Read(const YamlReader& y) {
   p.file = y.file();
   p.soil = ReadSceneSoil(y, "cone_penetrometer");
   p.level = ReadFidelityLevel<ConeLevel>(y, ReadLevel);  // every level checked, the named one used
-  // the soil: f directly, or from a requested cone index through a calibration table
-  // (through the table of the level's particle size and the friction: CI(f) depends on both)
+  // the soil: f directly, or from a requested cone index through the table of the level's
+  // particle size and the friction (CI(f) depends on both)
   p.friction = y.DoubleIn("friction", 0.0, 2.0);
-  if (y.Has("calibration")) p.calibration_file = y.ResolvePath(y.String("calibration"));
-  const bool by_ci = SoilStrengthByConeIndex(y);  // (the one an override gives, where both are there)
-  if (by_ci) {
-    p.requested_ci = y.Positive("cone_index");
-    if (p.calibration_file.empty()) y.Fail("calibration", "is needed to turn cone_index into f");
-    try {
-      p.calibration = CiCalibration::LoadFor(p.calibration_file, p.level.particle_diameter, p.friction);
-      p.cohesion_factor = p.calibration->CohesionFactor(p.requested_ci);
-    } catch (const ConfigError& e) {
-      y.Fail("cone_index", e.what());
-    }
-  } else {
-    if (!y.Has("cohesion_factor")) y.Fail("cohesion_factor", "is not set (nor is cone_index)");
-    p.cohesion_factor = y.Double("cohesion_factor");
-  }
-  if (!(p.cohesion_factor >= kMinCohesionFactor && p.cohesion_factor <= kMaxCohesionFactor))
-    y.Fail(by_ci ? "cone_index" : "cohesion_factor",
-           "the cohesion factor f = " + detail::Concat(p.cohesion_factor) + " lies outside the paper's range [" +
-               detail::Concat(kMinCohesionFactor) + ", " + detail::Concat(kMaxCohesionFactor) + "]");
+  p.strength = SoilStrength::Read(y, p.level.particle_diameter, p.friction, /*name_ci_of_f=*/false);
   p.soil.diameter = p.level.particle_diameter;
-  p.soil.cohesion_factor = p.cohesion_factor;
+  p.soil.cohesion_factor = p.strength.cohesion_factor;
   p.soil.friction = p.friction;
   p.threads = ReadThreads(y);
   p.seed = static_cast<unsigned>(y.Int("seed", 1));
@@ -305,9 +285,9 @@ ConeResult ConePenetrometer::Result() const {
   const double d = p_.level.particle_diameter, R = 0.5 * p_.level.container_diameter;
   r.level = p_.level.name;
   r.particles = dem_->num_alive();
-  r.cohesion_factor = p_.cohesion_factor;
+  r.cohesion_factor = p_.strength.cohesion_factor;
   r.friction = p_.friction;
-  r.requested_ci = p_.requested_ci;
+  r.requested_ci = p_.strength.requested_ci;
   r.surface_height = surface_;
   const double mass = r.particles * dem_->mass(), area = M_PI * R * R;
   if (prep_->height_poured() > 0.0) r.density_poured = mass / (area * prep_->height_poured());
@@ -358,7 +338,7 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
   f.Set("cohesion_factor", r.cohesion_factor);
   f.Set("friction", r.friction);
   if (std::isfinite(r.requested_ci)) f.Set("requested_cone_index_psi", r.requested_ci);
-  if (p.calibration) p.calibration->Describe(&f);  // which table f came from, and its error
+  if (p.strength.calibration) p.strength.calibration->Describe(&f);  // which table f came from, and its error
   f.Set("cone_index_psi", r.ci_psi);
   f.Set("cone_index_std_psi", r.ci_std_psi);
   f.Set("cone_index_trend_psi_per_m", r.ci_trend_psi_per_m);

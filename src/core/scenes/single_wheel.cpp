@@ -97,7 +97,7 @@ SingleWheelRig::SingleWheelRig(const SingleWheelParams& p, const DemSoilBin& pre
     : p_(p), wall0_(std::chrono::steady_clock::now()) {
   const DemSoilParams& a = p.bin;
   const DemSoilParams& b = prepared.params();
-  if (a.level.name != b.level.name || a.cohesion_factor != b.cohesion_factor || a.friction != b.friction ||
+  if (a.level.name != b.level.name || a.strength.cohesion_factor != b.strength.cohesion_factor || a.friction != b.friction ||
       a.seed != b.seed || a.soil.file != b.soil.file || prepared.wheels() != 1 ||
       prepared.tire().soil_mesh.faces.size() != p.tire.soil_mesh.faces.size() || prepared.tire().radius != p.tire.radius)
     throw ConfigError(p.file + ": the prepared bin was made for another soil, level, seed or tire");

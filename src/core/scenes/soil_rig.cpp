@@ -1,9 +1,6 @@
 #include "dem_mobility/core/scenes/soil_rig.h"
 
 #include "dem_mobility/core/common/error.h"
-#include "dem_mobility/core/common/registry.h"
-#include "dem_mobility/core/scenes/cone_penetrometer.h"
-#include "dem_mobility/core/scenes/single_wheel.h"
 
 namespace dem_mobility::core {
 
@@ -16,26 +13,6 @@ void RunSoilRig(SoilRig& rig, const std::function<void(const SoilRig&)>& progres
   } catch (const SimulationError& e) {
     rig.Fail(e.what());
   }
-}
-
-const std::vector<SoilRigKind>& SoilRigKinds() {
-  static const std::vector<SoilRigKind> kinds = {
-      {"cone_penetrometer",
-       [](const YamlReader& y) { return std::make_unique<ConePenetrometer>(ConeParams::Read(y)); }},
-      {"single_wheel",
-       [](const YamlReader& y) { return std::make_unique<SingleWheelRig>(SingleWheelParams::Read(y)); }},
-  };
-  return kinds;
-}
-
-bool IsSoilRigScene(const std::string& kind) {
-  for (const SoilRigKind& k : SoilRigKinds())
-    if (k.scene == kind) return true;
-  return false;
-}
-
-std::unique_ptr<SoilRig> MakeSoilRig(const YamlReader& y) {
-  return FindKind(y, "scene", SoilRigKinds(), [](const SoilRigKind& k) { return k.scene; }, "soil rig").make(y);
 }
 
 }  // namespace dem_mobility::core

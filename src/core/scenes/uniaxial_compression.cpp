@@ -8,7 +8,7 @@
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/scenes/soil_prep.h"
+#include "dem_mobility/core/soil/soil_prep.h"
 
 namespace dem_mobility::core {
 

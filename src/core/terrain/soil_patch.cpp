@@ -19,36 +19,6 @@ namespace {
 constexpr double kToolLowering = 0.5;  ///< [m/s] the leveling tools' descent to their working height
 }  // namespace
 
-SoilPatchParams SoilPatchParams::Read(const YamlReader& y) {
-  SoilPatchParams p;
-  p.enabled = true;
-  p.travel = y.DoubleIn("travel", 1.0, 1e5, p.travel);
-  p.sphere_margin = y.DoubleIn("sphere_margin", 0.0, 10.0, p.sphere_margin);
-  p.template_length = y.DoubleIn("template_length", 0.2, 100.0, p.template_length);
-  p.seam_clearance = y.DoubleIn("seam_clearance", 0.5, 1.0, p.seam_clearance);
-  if (y.Has("leveling")) {
-    const YamlReader l = y.Child("leveling");
-    p.leveling_ahead = l.DoubleIn("ahead", 0.0, 50.0, p.leveling_ahead);
-    p.leveling_radius = l.DoubleIn("radius", 0.01, 1.0, p.leveling_radius);
-    p.plate_length = l.DoubleIn("plate_length", 0.01, 10.0, p.plate_length);
-    p.leveling_clearance = l.DoubleIn("clearance", 0.0, 10.0, p.leveling_clearance);
-    l.Finish();
-  }
-  if (y.Has("check_window")) {
-    const std::vector<double> w = y.DoubleList("check_window");
-    if (w.size() != 2 || !(w[0] >= 0.0 && w[1] > w[0] && w[1] <= 50.0))
-      y.Fail("check_window", "expected [from, to] in m ahead of the front wheels' centres, 0 <= from < to <= 50");
-    p.check_from = w[0];
-    p.check_to = w[1];
-  }
-  p.check_period = y.DoubleIn("check_period", 1e-4, 10.0, p.check_period);
-  y.Finish();
-  if (p.check_to > p.leveling_ahead - p.plate_length)
-    y.Fail("check_window", detail::Concat("ends at ", p.check_to, " m, under the leveling plate (from ",
-                                          p.leveling_ahead - p.plate_length, " m ahead of the front wheels)"));
-  return p;
-}
-
 SoilPatch::SoilPatch(DemSoilBin* bin, const SoilPatchParams& p, unsigned seed)
     : bin_(bin), p_(p), rng_(0x5eed0000ULL + seed) {
   DM_THROW_UNLESS(p.enabled && bin->prepared() && bin->leveling_plate() >= 0, "SoilPatch: the bin has no patch or is not prepared");

@@ -73,4 +73,25 @@ void PlasticExchangeEnergies(const SoilContactLaw& law, double diameter, int thr
 /// `repetitions` evaluations on one thread.
 double PairLawThroughput(PairKernel kernel, const SoilContactLaw& law, double diameter, double dt, long repetitions);
 
+/// What the kernels' two sources share (pair_sweep.cpp, plastic_ledger_pass.cpp): the block of
+/// lanes their vector kernels work on, and the choice of a vector function's compiled instance.
+namespace pair_kernels {
+
+constexpr int kBlock = 32;  // pairs per block (of one slot or of several consecutive ones)
+constexpr int kPad = 8;     // a block's lanes are computed in multiples of this (one AVX-512 vector)
+
+// Of the three compiled instances of a vector function, the one `kernel` names (kAuto resolved for
+// this CPU; a kernel named outright taken as it is); nullptr for the scalar reference.
+template <class F>
+F InstanceOf(PairKernel kernel, F avx512, F avx2, F baseline) {
+  switch (kernel == PairKernel::kAuto ? ResolvePairKernel(kernel) : kernel) {
+    case PairKernel::kVectorAvx512: return avx512;
+    case PairKernel::kVectorAvx2: return avx2;
+    case PairKernel::kVectorBaseline: return baseline;
+    default: return nullptr;
+  }
+}
+
+}  // namespace pair_kernels
+
 }  // namespace dem_mobility::core

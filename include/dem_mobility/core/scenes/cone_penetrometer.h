@@ -14,14 +14,13 @@
 #include <functional>
 #include <limits>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "dem_mobility/core/dem/dem_system.h"
-#include "dem_mobility/core/scenes/calibration.h"
-#include "dem_mobility/core/scenes/soil_prep.h"
 #include "dem_mobility/core/scenes/soil_rig.h"
+#include "dem_mobility/core/soil/soil_prep.h"
+#include "dem_mobility/core/soil/soil_strength.h"
 
 namespace dem_mobility::core {
 
@@ -49,11 +48,8 @@ struct ConeParams {
   std::string file;
   SoilParams soil;                 ///< with the level's diameter, f and mu applied
   ConeLevel level;
-  double cohesion_factor = 1.0;    ///< f
   double friction = 0.1;           ///< inter-particle mu
-  double requested_ci = std::numeric_limits<double>::quiet_NaN();  ///< when f came from a calibration
-  std::string calibration_file;    ///< `calibration`: a table or a directory of tables
-  std::optional<CiCalibration> calibration;  ///< the table f came from (for the level's particles and mu)
+  SoilStrength strength;           ///< f, and the table it came from (for the level's particles and mu)
   int container_segments = 24;
   double solid_fraction = 0.58;    ///< poured solid fraction assumed for the particle count
   // the penetrometer (table 1)

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "dem_mobility/core/scenes/soil_rig.h"
-#include "dem_mobility/core/terrain/dem_soil.h"
+#include "dem_mobility/core/soil/dem_soil_bin.h"
 
 namespace dem_mobility::core {
 

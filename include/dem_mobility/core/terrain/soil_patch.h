@@ -33,7 +33,7 @@
 #include <string>
 #include <vector>
 
-#include "dem_mobility/core/terrain/dem_soil.h"
+#include "dem_mobility/core/soil/dem_soil_bin.h"
 
 namespace dem_mobility::core {
 

@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "dem_mobility/core/cosim/exchange.h"
+#include "dem_mobility/core/common/exchange.h"
 #include "dem_mobility/core/geometry/tire_geometry.h"
 #include "dem_mobility/core/geometry/trimesh.h"
 
@@ -94,14 +94,16 @@ struct PreparationProgress {
   std::string Line() const;
 };
 
-/// What a long preparation calls. `stop` (may be empty): every step; once it returns true the
+/// How a long preparation goes. `stop` (may be empty): called every step; once it returns true the
 /// preparation stops within a step and throws Interrupted saying where it was. `progress` (may be
-/// empty): when a phase begins, about every `progress_every` wall seconds within one, and when
-/// the preparation is done.
+/// empty): called when a phase begins, about every `progress_every` wall seconds within one, and
+/// when the preparation is done. `prepared_soil_cache` (may be empty): the folder of prepared
+/// soils (PreparedSoilCache) a soil is read from instead of prepared, and kept in once prepared.
 struct PreparationHooks {
   std::function<bool()> stop;
   std::function<void(const PreparationProgress&)> progress;
   double progress_every = 10.0;  ///< [s] of wall time
+  std::string prepared_soil_cache;
 };
 
 /// One kind of terrain: the `model:` key of its files, a factory and a describer.

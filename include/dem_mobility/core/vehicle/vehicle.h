@@ -5,14 +5,14 @@
 #include <memory>
 #include <string>
 
-#include "dem_mobility/core/cosim/exchange.h"
+#include "dem_mobility/core/common/exchange.h"
 #include "dem_mobility/core/multibody/multibody_system.h"
 #include "dem_mobility/core/vehicle/powertrain.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 
 namespace dem_mobility::core {
 
-/// Wheel order everywhere (kWheelNames, cosim/exchange.h): front left, front right, rear left, rear right.
+/// Wheel order everywhere (kWheelNames, common/exchange.h): front left, front right, rear left, rear right.
 enum WheelIndex { kFrontLeft = 0, kFrontRight = 1, kRearLeft = 2, kRearRight = 3 };
 
 /// A vehicle assembled in a MultibodySystem from a VehicleSpec: chassis; per corner upper and

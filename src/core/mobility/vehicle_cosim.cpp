@@ -1,4 +1,4 @@
-#include "dem_mobility/core/cosim/vehicle_cosim.h"
+#include "dem_mobility/core/mobility/vehicle_cosim.h"
 #include "dem_mobility/core/common/state_archive.h"
 
 #include <cmath>

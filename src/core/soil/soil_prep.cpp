@@ -1,4 +1,4 @@
-#include "dem_mobility/core/scenes/soil_prep.h"
+#include "dem_mobility/core/soil/soil_prep.h"
 #include "dem_mobility/core/common/state_archive.h"
 
 #include <algorithm>

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "dem_mobility/core/cosim/exchange.h"
+#include "dem_mobility/core/common/exchange.h"
 #include "dem_mobility/core/vehicle/driver.h"
 
 namespace dem_mobility::core {

@@ -1,4 +1,4 @@
-#include "dem_mobility/core/scenes/calibration.h"
+#include "dem_mobility/core/soil/calibration.h"
 
 #include <algorithm>
 #include <cctype>
@@ -249,17 +249,6 @@ double CiCalibration::ConeIndex(double fac) const {
   DM_THROW_UNLESS(fac >= f.front() && fac <= f.back(), file, ": cohesion factor ", fac,
                   " lies outside the calibrated range [", f.front(), ", ", f.back(), "]");
   return Interpolate(f, ci, fac);
-}
-
-bool SoilStrengthByConeIndex(const YamlReader& y) {
-  if (!y.Has("cone_index")) return false;
-  if (!y.Has("cohesion_factor")) return true;
-  const bool ci = y.Overridden("cone_index");
-  if (ci == y.Overridden("cohesion_factor"))
-    y.Fail("cohesion_factor", std::string("and cone_index are both given") + (ci ? " by overrides" : " in the file") +
-                                  ": give one of them (an override of either takes the place of the other in the file)");
-  y.Double(ci ? "cohesion_factor" : "cone_index");
-  return ci;
 }
 
 }  // namespace dem_mobility::core

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "dem_mobility/core/common/time_step.h"
-#include "dem_mobility/core/cosim/ports.h"
-#include "dem_mobility/core/mobility/mobility_run.h"
+#include "dem_mobility/core/mobility/ports.h"
+#include "dem_mobility/core/mobility/mobility_result.h"
 #include "dem_mobility/core/vehicle/vehicle.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 

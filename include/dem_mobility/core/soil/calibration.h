@@ -68,11 +68,4 @@ struct CiCalibration {
   double ConeIndex(double f) const;
 };
 
-/// Whether a soil's strength is given by its `cone_index` (true) or by its `cohesion_factor` in the
-/// map `y`. Where both are there, the one an override set takes the place of the other in the file
-/// (which is then read, so that it is no unknown key); both in the file, or both overridden, is
-/// refused naming the file and cohesion_factor. Neither: false (the caller then needs
-/// cohesion_factor).
-bool SoilStrengthByConeIndex(const YamlReader& y);
-
 }  // namespace dem_mobility::core

@@ -1,18 +1,20 @@
-// The scene kinds and how each runs from the command line (dm_run_scene).
-#include "dem_mobility/core/scenes/scene_registry.h"
+// The scene kinds and how each runs from the command line (dm_run_scene): the console lines of a
+// run, its checkpoints and its result file.
+#include "dem_mobility/tools/scene_runners.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/input_files.h"
 #include "dem_mobility/core/common/registry.h"
 #include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/common/yaml_reader.h"
-#include "dem_mobility/core/mobility/mobility_scene.h"
+#include "dem_mobility/core/mobility/mobility_run.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
 #include "dem_mobility/core/scenes/dem_pour.h"
 #include "dem_mobility/core/scenes/single_wheel.h"
@@ -50,8 +52,6 @@ ResultFile BeforeTheRun(const MobilityRunParams& p, const SceneRunOptions& o,
   r.interrupted = status == "interrupted";
   if (!r.interrupted) r.error = why;
   r.terrain = DescribeTerrain(p.terrain_file, p.terrain_overrides);
-  r.terrain_model = r.terrain.model;
-  r.cone_index = r.terrain.cone_index;
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   std::printf("%s\n", why.c_str());
   if (!o.history_file.empty()) WriteMobilityHistory(r, o.history_file);
@@ -60,157 +60,187 @@ ResultFile BeforeTheRun(const MobilityRunParams& p, const SceneRunOptions& o,
   return f;
 }
 
-ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) {
-  const MobilityRunParams p = MobilityRunParams::Read(reader);
+/// The console and the checkpoints of a mobility run: progress about once a second of wall time,
+/// a checkpoint when the run begins to step, every checkpoint_every wall seconds and when it is
+/// told to stop.
+class MobilityConsole final : public CoSimObserver {
+ public:
+  MobilityConsole(const MobilityRun& run, const SceneRunOptions& o, const CheckpointIdentity& id, double duration,
+                  bool restarted)
+      : run_(run), o_(o), id_(id), duration_(duration), restarted_(restarted) {}
+  bool StopRequested() override { return o_.stop && o_.stop->load(std::memory_order_relaxed); }
+  void AtStepStart(const VehicleCoSim& sim, const CoSimLoopState& st) override {
+    if (o_.checkpoint_file.empty()) return;
+    // (looked at every 256 steps)
+    const bool first = written_ == 0 && !failed_ && !restarted_;
+    if (!first && !StopRequested() && ((sim.step() & 255) != 0 || since_.Elapsed() < o_.checkpoint_every)) return;
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      const uint64_t bytes = run_.WriteCheckpoint(o_.checkpoint_file, id_, st);
+      ++written_;
+      last_t_ = sim.driver_time();
+      std::printf("  checkpoint %s: t = %.3f s, %.1f MB in %.2f s\n", o_.checkpoint_file.c_str(), last_t_,
+                  bytes / 1e6, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    } catch (const ConfigError& e) {  // (the run goes on; its result says the checkpoint failed)
+      failed_ = true;
+      error_ = e.what();
+      std::printf("  checkpoint failed: %s\n", e.what());
+    }
+    std::fflush(stdout);
+    since_ = Ticker(0.0);
+  }
+  void OnStep(const VehicleCoSim& sim, const DriverCommand&) override {
+    if (t0_ < 0.0) t0_ = sim.time();  // (the first step this process makes: after a restart, not 0)
+    if (o_.quiet || (sim.step() & 255) != 0 || !ticker_.Due()) return;
+    const double t = std::max(0.0, sim.driver_time());
+    const double rtf = (sim.time() - t0_) / std::max(ticker_.Elapsed(), 1e-9);
+    std::printf("  t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s\n", t, duration_,
+                sim.vehicle().ForwardSpeed(), rtf, (duration_ - t) / std::max(rtf, 1e-9));
+    std::fflush(stdout);
+  }
+  int written() const { return written_; }
+  double last_t() const { return last_t_; }
+  const std::string& error() const { return error_; }
+
+ private:
+  const MobilityRun& run_;
+  const SceneRunOptions& o_;
+  const CheckpointIdentity& id_;
+  double duration_;
+  bool restarted_;
+  double t0_ = -1.0;  ///< the simulated time progress is reckoned from (this process's start)
+  Ticker ticker_{1.0};
+  Ticker since_{0.0};  ///< since the last checkpoint
+  int written_ = 0;
+  bool failed_ = false;
+  double last_t_ = 0.0;
+  std::string error_;
+};
+
+/// A mobility run taken up from a checkpoint or built afresh (the terrain prepared), with what a
+/// checkpoint of it records. `before` is set instead when it stopped before it began.
+struct StartedRun {
+  std::unique_ptr<MobilityRun> run;
+  CoSimLoopState resume;
+  CheckpointIdentity restarted, identity;
+  std::optional<ResultFile> before;
+};
+
+StartedRun StartMobilityRun(const YamlReader& reader, const MobilityRunParams& p, const SceneRunOptions& o) {
   const auto wall0 = std::chrono::steady_clock::now();
   // what the checkpoints record of the run: the scene (read before this), then every input file
   // the run reads from here on
   InputFileRecord inputs;
   NoteInputFile(reader.file());
-  std::unique_ptr<MobilityRun> made;
-  CoSimLoopState resume;
-  CheckpointIdentity restarted;
+  StartedRun s;
   const bool restart = !o.restart_file.empty();
   if (restart) {
     // (ConfigError for a checkpoint of another run, or one that does not read)
-    made = MobilityRun::FromCheckpoint(o.restart_file, p, o.scene_file.empty() ? reader.file() : o.scene_file,
-                                       o.overrides, &resume, &restarted);
+    s.run = MobilityRun::FromCheckpoint(o.restart_file, p, o.scene_file.empty() ? reader.file() : o.scene_file,
+                                        o.overrides, &s.resume, &s.restarted);
     std::printf("restarted from %s at t = %.3f s (step %ld; %.0f s of wall time before)\n", o.restart_file.c_str(),
-                restarted.driver_time, restarted.step, resume.r.wall_time);
+                s.restarted.driver_time, s.restarted.step, s.resume.r.wall_time);
   } else {
     try {
       PreparationHooks hooks;
-      hooks.stop = [s = o.stop] { return s && s->load(std::memory_order_relaxed); };
+      hooks.stop = [stop = o.stop] { return stop && stop->load(std::memory_order_relaxed); };
+      hooks.prepared_soil_cache = o.prepared_soil_cache;
       if (!o.quiet)  // (a soil at a fine level prepares for minutes to hours)
         hooks.progress = [](const PreparationProgress& at) {
           std::printf("  preparing the terrain: %s\n", at.Line().c_str());
           std::fflush(stdout);
         };
-      made = std::make_unique<MobilityRun>(p, hooks);
+      s.run = std::make_unique<MobilityRun>(p, hooks);
     } catch (const Interrupted& e) {
       // stopped while the terrain prepared, before the run began: the result and the history (its
       // header) say so, the result with how far the preparation had come
-      return BeforeTheRun(p, o, wall0, "interrupted", e.what());
+      s.before = BeforeTheRun(p, o, wall0, "interrupted", e.what());
+      return s;
     } catch (const SimulationError& e) {
       // a numerical failure in the terrain's preparation or the opening exchange (a watchdog): the
       // result says so, as a failure during a run does
-      return BeforeTheRun(p, o, wall0, "error", e.what());
+      s.before = BeforeTheRun(p, o, wall0, "error", e.what());
+      return s;
     }
   }
-  MobilityRun& run = *made;
-  CheckpointIdentity identity;
-  identity.scene_file = restart ? restarted.scene_file
-                                : std::filesystem::absolute(o.scene_file.empty() ? reader.file() : o.scene_file)
-                                      .lexically_normal()
-                                      .string();
-  identity.overrides = o.overrides;
-  identity.files = restart ? restarted.files : inputs.Files();
-  identity.executable = ExecutableFingerprint();
+  CheckpointIdentity& id = s.identity;
+  id.scene_file = restart ? s.restarted.scene_file
+                          : std::filesystem::absolute(o.scene_file.empty() ? reader.file() : o.scene_file)
+                                .lexically_normal()
+                                .string();
+  id.overrides = o.overrides;
+  id.files = restart ? s.restarted.files : inputs.Files();
+  id.executable = ExecutableFingerprint();
+  return s;
+}
+
+/// The history and, with a moving patch, its checks of the soil ahead (<history>.patch_checks.csv).
+void WriteMobilityFiles(MobilityRunResult* r, const MobilityRun& run, const SceneRunOptions& o) {
+  try {
+    if (o.history_file.empty()) return;
+    WriteMobilityHistory(*r, o.history_file);
+    const auto* soil = dynamic_cast<const DemSoilTerrain*>(&run.terrain());
+    if (soil && soil->patch()) {
+      const std::string& h = o.history_file;
+      const size_t dot = h.rfind(".csv");
+      WritePatchChecks(soil->patch()->stats(),
+                       (dot != std::string::npos && dot + 4 == h.size() ? h.substr(0, dot) : h) + ".patch_checks.csv");
+    }
+  } catch (const ConfigError& e) {  // the run is kept: its result says what failed
+    if (r->error.empty()) r->error = e.what();
+  }
+}
+
+/// What the result says of the checkpoints; the checkpoint is kept for a restart after an error or
+/// an interrupt, and removed once the run has ended (its result is then what remains).
+void SettleCheckpoint(ResultFile* f, const MobilityRunResult& r, const SceneRunOptions& o,
+                      const MobilityConsole& console, const StartedRun& s) {
+  const bool restart = !o.restart_file.empty();
+  if (restart) {
+    f->Set("restarted_from", o.restart_file);
+    f->Set("restarted_at", s.restarted.driver_time);
+  }
+  if (o.checkpoint_file.empty()) return;
+  f->Set("checkpoints_written", console.written());
+  if (!console.error().empty()) f->Set("checkpoint_error", console.error());
+  // the checkpoint file holds this run: one it wrote, or the one it was taken up from
+  std::error_code ec;
+  const bool same = restart && std::filesystem::equivalent(o.restart_file, o.checkpoint_file, ec);
+  const bool holds = console.written() > 0 || same;
+  const double at = console.written() > 0 ? console.last_t() : s.restarted.driver_time;
+  const std::string status = r.Status();
+  if (status == "error" || status == "interrupted") {
+    if (holds) {
+      f->Set("checkpoint", o.checkpoint_file);
+      f->Set("checkpoint_at", at);
+      std::printf("checkpoint kept: %s (t = %.3f s): --restart %s takes the run up from there\n",
+                  o.checkpoint_file.c_str(), at, o.checkpoint_file.c_str());
+    }
+  } else if (holds) {
+    std::remove(o.checkpoint_file.c_str());
+  }
+}
+
+ResultFile RunMobilityScene(const YamlReader& reader, const SceneRunOptions& o) {
+  const MobilityRunParams p = MobilityRunParams::Read(reader);
+  StartedRun s = StartMobilityRun(reader, p, o);
+  if (s.before) return *s.before;
+  MobilityRun& run = *s.run;
   const TimeStepLimit& lim = run.sim().limit();
   std::printf("scene %s: grade %.1f deg, %d bodies, dt %.3g s (critical %.3g s, %s), %.1f s simulated\n",
               p.file.c_str(), p.grade_deg, run.vehicle().system().num_bodies() - 1, run.dt(), lim.dt_crit,
               lim.element.c_str(), p.duration);
   std::fflush(stdout);
-  // progress on the console about once a second of wall time; the checkpoints
-  class Progress final : public CoSimObserver {
-   public:
-    Progress(const MobilityRun& run, const SceneRunOptions& o, const CheckpointIdentity& id, double duration,
-             bool restarted)
-        : run_(run), o_(o), id_(id), duration_(duration), restarted_(restarted) {}
-    bool StopRequested() override { return o_.stop && o_.stop->load(std::memory_order_relaxed); }
-    void AtStepStart(const VehicleCoSim& sim, const CoSimLoopState& st) override {
-      if (o_.checkpoint_file.empty()) return;
-      // when the run begins to step, every checkpoint_every wall seconds (looked at every 256
-      // steps), and when it is told to stop
-      const bool first = written_ == 0 && !failed_ && !restarted_;
-      if (!first && !StopRequested() && ((sim.step() & 255) != 0 || since_.Elapsed() < o_.checkpoint_every)) return;
-      const auto t0 = std::chrono::steady_clock::now();
-      try {
-        const uint64_t bytes = run_.WriteCheckpoint(o_.checkpoint_file, id_, st);
-        ++written_;
-        last_t_ = sim.driver_time();
-        std::printf("  checkpoint %s: t = %.3f s, %.1f MB in %.2f s\n", o_.checkpoint_file.c_str(), last_t_,
-                    bytes / 1e6, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      } catch (const ConfigError& e) {  // (the run goes on; its result says the checkpoint failed)
-        failed_ = true;
-        error_ = e.what();
-        std::printf("  checkpoint failed: %s\n", e.what());
-      }
-      std::fflush(stdout);
-      since_ = Ticker(0.0);
-    }
-    void OnStep(const VehicleCoSim& sim, const DriverCommand&) override {
-      if (t0_ < 0.0) t0_ = sim.time();  // (the first step this process makes: after a restart, not 0)
-      if (o_.quiet || (sim.step() & 255) != 0 || !ticker_.Due()) return;
-      const double t = std::max(0.0, sim.driver_time());
-      const double rtf = (sim.time() - t0_) / std::max(ticker_.Elapsed(), 1e-9);
-      std::printf("  t = %6.2f / %.0f s  speed %6.2f m/s  real-time factor %.2f  ETA %.0f s\n", t, duration_,
-                  sim.vehicle().ForwardSpeed(), rtf, (duration_ - t) / std::max(rtf, 1e-9));
-      std::fflush(stdout);
-    }
-    int written() const { return written_; }
-    double last_t() const { return last_t_; }
-    const std::string& error() const { return error_; }
-
-   private:
-    const MobilityRun& run_;
-    const SceneRunOptions& o_;
-    const CheckpointIdentity& id_;
-    double duration_;
-    bool restarted_;
-    double t0_ = -1.0;  ///< the simulated time progress is reckoned from (this process's start)
-    Ticker ticker_{1.0};
-    Ticker since_{0.0};  ///< since the last checkpoint
-    int written_ = 0;
-    bool failed_ = false;
-    double last_t_ = 0.0;
-    std::string error_;
-  } progress(run, o, identity, p.duration, restart);
-  MobilityRunResult r = run.Run(&progress, restart ? &resume : nullptr);
-  try {
-    if (!o.history_file.empty()) {
-      WriteMobilityHistory(r, o.history_file);
-      // the moving patch's checks of the soil ahead beside it (<history>.patch_checks.csv)
-      const auto* soil = dynamic_cast<const DemSoilTerrain*>(&run.terrain());
-      if (soil && soil->patch()) {
-        const std::string& h = o.history_file;
-        const size_t dot = h.rfind(".csv");
-        WritePatchChecks(soil->patch()->stats(),
-                         (dot != std::string::npos && dot + 4 == h.size() ? h.substr(0, dot) : h) + ".patch_checks.csv");
-      }
-    }
-  } catch (const ConfigError& e) {  // the run is kept: its result says what failed
-    if (r.error.empty()) r.error = e.what();
-  }
+  const bool restart = !o.restart_file.empty();
+  MobilityConsole console(run, o, s.identity, p.duration, restart);
+  MobilityRunResult r = run.Run(&console, restart ? &s.resume : nullptr);
+  WriteMobilityFiles(&r, run, o);
   std::printf("speed_made_good: %.3f m/s (%.2f mph), status %s, window slope %.4f m/s^2\n", r.smg.value,
               r.smg.value / 0.44704, r.smg.status.c_str(), r.smg.window_slope);
   std::printf("run: %ld steps, %.2f s simulated in %.2f s wall (real-time factor %.2f)\n", r.steps, r.sim_time,
               r.wall_time, r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0);
   ResultFile f = MobilityResultFile(r, p, {}, &run.terrain());
-  if (restart) {
-    f.Set("restarted_from", o.restart_file);
-    f.Set("restarted_at", restarted.driver_time);
-  }
-  if (!o.checkpoint_file.empty()) {
-    f.Set("checkpoints_written", progress.written());
-    if (!progress.error().empty()) f.Set("checkpoint_error", progress.error());
-    // the checkpoint file holds this run: one it wrote, or the one it was taken up from
-    std::error_code ec;
-    const bool same = restart && std::filesystem::equivalent(o.restart_file, o.checkpoint_file, ec);
-    const bool holds = progress.written() > 0 || same;
-    const double at = progress.written() > 0 ? progress.last_t() : restarted.driver_time;
-    const std::string status = r.Status();
-    if (status == "error" || status == "interrupted") {
-      if (holds) {
-        f.Set("checkpoint", o.checkpoint_file);
-        f.Set("checkpoint_at", at);
-        std::printf("checkpoint kept: %s (t = %.3f s): --restart %s takes the run up from there\n",
-                    o.checkpoint_file.c_str(), at, o.checkpoint_file.c_str());
-      }
-    } else if (holds) {
-      std::remove(o.checkpoint_file.c_str());  // the run has ended: its result is what remains
-    }
-  }
+  SettleCheckpoint(&f, r, o, console, s);
   return f;
 }
 
@@ -238,7 +268,7 @@ ResultFile RunConeScene(const YamlReader& reader, const SceneRunOptions& o) {
   const ConeParams p = ConeParams::Read(reader);
   std::printf("scene %s: level '%s', f %.4g, mu %.3g, %d particles of %.3g m in a %.3g m container, cone at %.3g m/s, "
               "dt %.3g s, %d thread(s)\n",
-              p.file.c_str(), p.level.name.c_str(), p.cohesion_factor, p.friction, p.ParticleCount(),
+              p.file.c_str(), p.level.name.c_str(), p.strength.cohesion_factor, p.friction, p.ParticleCount(),
               p.level.particle_diameter, p.level.container_diameter, p.level.cone_speed, p.level.time_step, p.threads);
   std::fflush(stdout);
   ConePenetrometer rig(p);
@@ -266,7 +296,7 @@ ResultFile RunSingleWheelScene(const YamlReader& reader, const SceneRunOptions& 
   const SoilBinLevel& l = p.bin.level;
   std::printf("scene %s: level '%s', f %.4g, mu %.3g, %d particles of %.3g m in a %.3g x %.3g m bin, dt %.3g s, "
               "%d thread(s); wheel %s, load %.0f kg, carriage %.3g m/s\n",
-              p.file.c_str(), l.name.c_str(), p.bin.cohesion_factor, p.bin.friction, p.bin.ParticleCount(),
+              p.file.c_str(), l.name.c_str(), p.bin.strength.cohesion_factor, p.bin.friction, p.bin.ParticleCount(),
               l.particle_diameter, l.length, l.width, l.time_step, p.bin.threads,
               p.drive == SingleWheelParams::Drive::kSlip ? ("at slip " + std::to_string(p.slip)).c_str()
                                                           : SingleWheelParams::DriveName(p.drive),

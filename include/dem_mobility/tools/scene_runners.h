@@ -1,7 +1,8 @@
 // The scenes there are, by their `scene:` key: each reads its file, runs to the end (printing its
 // progress and a summary), and returns its result in the one result schema (common/result_file.h).
 // dm_run_scene runs any of them; the soil rigs among them also run in the rig nodelet
-// (scenes/soil_rig.h), the mobility run in the vehicle, terrain and driver nodelets.
+// (core/scenes/soil_rig.h), the mobility run in the vehicle, terrain and driver nodelets. This is
+// the tools' room: the library computes and reports in its result; the console is here.
 #pragma once
 
 #include <atomic>
@@ -24,12 +25,14 @@ struct SceneRunOptions {
   /// Mobility runs: the run's checkpoint ("" none), written when the run begins to step (the soil
   /// prepared), every `checkpoint_every` wall seconds, and when it is stopped from outside; kept
   /// when the run stops with an error or is interrupted, removed once it has ended (its result
-  /// is then what remains). A restart from it goes on bit for bit (mobility/mobility_scene.h).
+  /// is then what remains). A restart from it goes on bit for bit (mobility/mobility_run.h).
   std::string checkpoint_file;
   double checkpoint_every = 600.0;  ///< [s] of wall time
   /// Mobility runs: take the run up from this checkpoint ("" from the start); it must be of the
   /// same scene file, overrides, input files and build.
   std::string restart_file;
+  /// Mobility runs: the folder of prepared soils ("" none; PreparationHooks::prepared_soil_cache).
+  std::string prepared_soil_cache;
   /// What a checkpoint records of the run (and a restart checks): the scene file and the
   /// key=value overrides as given.
   std::string scene_file;

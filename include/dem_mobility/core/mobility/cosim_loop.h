@@ -4,14 +4,14 @@
 
 #include <chrono>
 
-#include "dem_mobility/core/cosim/ports.h"
-#include "dem_mobility/core/cosim/vehicle_cosim.h"
-#include "dem_mobility/core/mobility/mobility_run.h"
+#include "dem_mobility/core/mobility/ports.h"
+#include "dem_mobility/core/mobility/vehicle_cosim.h"
+#include "dem_mobility/core/mobility/mobility_result.h"
 
 namespace dem_mobility::core {
 
 /// The loop's own state between two steps: what a checkpoint keeps beside the vehicle, the
-/// terrain and the driver (common/state_archive.h, mobility/mobility_scene.h).
+/// terrain and the driver (common/state_archive.h, mobility/mobility_run.h).
 struct CoSimLoopState {
   MobilityRunResult r;   ///< the history, ledger and counts so far
   DriverCommand cmd;     ///< the command in force

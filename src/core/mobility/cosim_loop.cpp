@@ -1,4 +1,4 @@
-#include "dem_mobility/core/cosim/cosim_loop.h"
+#include "dem_mobility/core/mobility/cosim_loop.h"
 
 #include <algorithm>
 #include <chrono>
@@ -41,6 +41,25 @@ std::string Unstable(const VehicleCoSim& sim, const LedgerWatch& w) {
                         sim.limit().dt_crit, " s, ", sim.limit().element, ")");
 }
 
+/// The driver's command for the vehicle's state at `t` (since the driver's start; its control
+/// period `period`), put on the vehicle.
+DriverCommand AskDriver(VehicleCoSim& sim, DriverPort& driver, double t, double period, const Eigen::Vector3d& p0) {
+  Vehicle& veh = sim.vehicle();
+  DriverInput in;
+  in.step = sim.step();
+  in.time = t;
+  in.period = period;
+  in.forward_speed = veh.ForwardSpeed();
+  in.drive_shaft_speed = veh.DriveShaftSpeed();
+  in.lateral_offset = veh.ChassisFramePosition().y() - p0.y();
+  in.heading = veh.Heading();
+  const DriverCommand cmd = driver.Exchange(in);
+  veh.SetDriveTorqueRequest(cmd.drive_torque);
+  veh.SetBrakeEffort(cmd.brake_effort);
+  veh.SetSteering(cmd.steering);
+  return cmd;
+}
+
 }  // namespace
 
 MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, DriverPort& driver, CoSimObserver* observer,
@@ -57,8 +76,6 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
   r.dt_crit = sim.limit().dt_crit;
   r.dt_limit_element = sim.limit().element;
   r.terrain = terrain.description();
-  r.terrain_model = r.terrain.model;
-  r.cone_index = r.terrain.cone_index;
   r.coupling_interval = sim.coupling_interval();
   Vehicle& veh = sim.vehicle();
   const double dt = sim.dt();
@@ -92,21 +109,9 @@ MobilityRunResult RunCoSimulation(VehicleCoSim& sim, TerrainPort& terrain, Drive
         if (k == 0) p0 = veh.ChassisFramePosition();
         const double t = k * dt;
         const double v = veh.ForwardSpeed();
-        const double w_ds = veh.DriveShaftSpeed();
         if (k % control_every == 0) {
-          DriverInput in;
-          in.step = sim.step();
-          in.time = t;
-          in.period = control_every * dt;
-          in.forward_speed = v;
-          in.drive_shaft_speed = w_ds;
-          in.lateral_offset = veh.ChassisFramePosition().y() - p0.y();
-          in.heading = veh.Heading();
-          cmd = driver.Exchange(in);
+          cmd = AskDriver(sim, driver, t, control_every * dt, p0);
           ++r.driver_updates;
-          veh.SetDriveTorqueRequest(cmd.drive_torque);
-          veh.SetBrakeEffort(cmd.brake_effort);
-          veh.SetSteering(cmd.steering);
         }
         if (k % sample_every == 0) {
           r.history.push_back(Sample(sim, t, p0, cmd));

@@ -1,4 +1,4 @@
-#include "dem_mobility/core/cosim/ports.h"
+#include "dem_mobility/core/mobility/ports.h"
 
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"

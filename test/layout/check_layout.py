@@ -1,0 +1,215 @@
+#!/usr/bin/env python3
+"""The layout's rules, checked against the code (docs/layout.md says them; this holds them):
+
+1. The core's rooms (include/dem_mobility/core/ROOM, src/core/ROOM) stand in the order of
+   docs/layout.md's room table; a room includes only itself and the rooms above it. The core
+   includes nothing of the ROS layer (dem_mobility/ros, ros/, any message header).
+2. No file of the core includes itself back through others (no cycle of includes).
+3. No source file (the library, the nodelets, the tools, the benchmarks) is longer than
+   MAX_FILE_LINES lines, and no function longer than MAX_FUNCTION_LINES, except the ones named in
+   EXCEPTIONS with their reason.
+
+Usage: check_layout.py REPO     (exit 1 naming every breach)
+       check_layout.py --self-test  (breaches planted in a copy must be found)
+"""
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+MAX_FILE_LINES = 600
+MAX_FUNCTION_LINES = 100
+# Functions allowed past MAX_FUNCTION_LINES, each with its reason.
+EXCEPTIONS = {
+    'src/core/dem/neighbour_list.cpp:ListPairs':
+        'a DEM hot loop: the cell walk appends pairs without a branch; split, its state would pass through calls',
+    'src/core/dem/wall_contacts.cpp:ComputeSlot':
+        'a DEM hot loop: one slot against every wall with candidates, run for every particle every step',
+}
+
+INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
+CORE_INCLUDE = re.compile(r'^dem_mobility/core/([a-z_]+)/([A-Za-z0-9_.]+)$')
+
+
+def room_order(repo):
+    """The rooms in docs/layout.md's table, top first."""
+    text = open(os.path.join(repo, 'docs', 'layout.md'), encoding='utf-8').read()
+    rooms = re.findall(r'^\| `([a-z_]+)/` \|', text, re.M)
+    if not rooms:
+        raise SystemExit('docs/layout.md: no room table (rows "| `room/` | ... |") found')
+    return rooms
+
+
+def core_files(repo):
+    """(room, path relative to repo) of every header and source of the core."""
+    out = []
+    for base in ('include/dem_mobility/core', 'src/core'):
+        top = os.path.join(repo, base)
+        for room in sorted(os.listdir(top)):
+            d = os.path.join(top, room)
+            if not os.path.isdir(d):
+                continue
+            for dirpath, _, files in os.walk(d):
+                for f in sorted(files):
+                    if f.endswith(('.h', '.cpp')):
+                        out.append((room, os.path.relpath(os.path.join(dirpath, f), repo)))
+    return out
+
+
+def check_rooms(repo):
+    order = room_order(repo)
+    breaches = []
+    graph = {}
+    for room, path in core_files(repo):
+        if room not in order:
+            breaches.append(f'{path}: room {room}/ is not in docs/layout.md\'s room table')
+            continue
+        text = open(os.path.join(repo, path), encoding='utf-8').read()
+        node = path_key(path)
+        graph.setdefault(node, set())
+        for inc in INCLUDE.findall(text):
+            m = CORE_INCLUDE.match(inc)
+            if inc.startswith('dem_mobility/ros/') or inc.startswith('ros/') or inc.startswith('dem_mobility/') and not m:
+                breaches.append(f'{path}: includes {inc}: the core includes nothing of the ROS layer')
+                continue
+            if not m:
+                continue
+            other = m.group(1)
+            graph[node].add(f'{other}/{os.path.splitext(m.group(2))[0]}')
+            if other not in order:
+                breaches.append(f'{path}: includes {inc}: room {other}/ is not in docs/layout.md')
+            elif order.index(other) > order.index(room):
+                breaches.append(f'{path}: includes {inc}: room {other}/ stands below {room}/ in docs/layout.md')
+    breaches += [f'include cycle: {" -> ".join(c)}' for c in cycles(graph)]
+    return breaches
+
+
+def path_key(path):
+    """include/dem_mobility/core/soil/x.h and src/core/soil/x.cpp are one unit, soil/x."""
+    parts = path.split('/')
+    room = parts[3] if parts[0] == 'include' else parts[2]
+    return f'{room}/{os.path.splitext(parts[-1])[0]}'
+
+
+def cycles(graph):
+    """The strongly connected components of more than one unit (Tarjan)."""
+    index, low, stack, on, out = {}, {}, [], set(), []
+    counter = [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in sorted(graph.get(v, ())):
+            if w not in graph:
+                continue
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    sys.setrecursionlimit(10000)
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def sources(repo):
+    for base in ('include', 'src', 'bench'):
+        for dirpath, _, files in os.walk(os.path.join(repo, base)):
+            for f in sorted(files):
+                if f.endswith(('.h', '.cpp')):
+                    yield os.path.relpath(os.path.join(dirpath, f), repo)
+
+
+def check_sizes(repo):
+    breaches = []
+    paths = list(sources(repo))
+    for path in paths:
+        n = sum(1 for _ in open(os.path.join(repo, path), encoding='utf-8'))
+        if n > MAX_FILE_LINES:
+            breaches.append(f'{path}: {n} lines (at most {MAX_FILE_LINES})')
+    # functions: universal-ctags gives each definition's first and last line
+    out = subprocess.run(['ctags-universal', '-x', '--_xformat=%N\t%F\t%n\t%{end}', '--kinds-C++=f', '--fields=+ne',
+                          '--language-force=C++', *paths], cwd=repo, capture_output=True, text=True, check=True).stdout
+    for line in out.splitlines():
+        name, path, start, end = line.split('\t')
+        if not end.isdigit():
+            continue
+        length = int(end) - int(start) + 1
+        if length > MAX_FUNCTION_LINES and f'{path}:{name}' not in EXCEPTIONS:
+            breaches.append(f'{path}:{start}: {name} is {length} lines (at most {MAX_FUNCTION_LINES})')
+    return breaches
+
+
+def check(repo):
+    return check_rooms(repo) + check_sizes(repo)
+
+
+def self_test():
+    """Plants one breach of each rule in a copy of the checkout; each must be found."""
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    failures = []
+    with tempfile.TemporaryDirectory() as tmp:
+        copy = os.path.join(tmp, 'repo')
+        for d in ('include', 'src', 'bench', 'docs'):
+            shutil.copytree(os.path.join(repo, d), os.path.join(copy, d))
+        clean = '\n'.join(check(copy))
+        order = room_order(copy)
+        top, bottom = order[0], order[-1]
+        planted = os.path.join(copy, 'include', 'dem_mobility', 'core', top, 'planted.h')
+        with open(planted, 'w') as f:
+            f.write(f'#pragma once\n#include "dem_mobility/core/{bottom}/planted_low.h"\n')
+        low = os.path.join(copy, 'include', 'dem_mobility', 'core', bottom, 'planted_low.h')
+        with open(low, 'w') as f:
+            f.write(f'#pragma once\n#include "dem_mobility/core/{top}/planted.h"\n')
+        long_fn = os.path.join(copy, 'src', 'core', top, 'planted_long.cpp')
+        with open(long_fn, 'w') as f:
+            f.write('int Planted() {\n' + '  int a = 0;\n' * MAX_FUNCTION_LINES + '  return a;\n}\n')
+        long_file = os.path.join(copy, 'src', 'core', top, 'planted_file.cpp')
+        with open(long_file, 'w') as f:
+            f.write('// line\n' * (MAX_FILE_LINES + 1))
+        found = '\n'.join(check(copy))
+        for what, needle in (('an include against the order', f'room {bottom}/ stands below {top}/'),
+                             ('a cycle', 'include cycle:'),
+                             ('a long function', 'Planted is'),
+                             ('a long file', 'planted_file.cpp: ')):
+            if needle in clean:
+                failures.append(f'{what}: "{needle}" is reported before anything is planted')
+            elif needle not in found:
+                failures.append(f'{what} was not found')
+    for f in failures:
+        print('self-test:', f)
+    return 1 if failures else 0
+
+
+def main(argv):
+    if argv[1:] == ['--self-test']:
+        return self_test()
+    if len(argv) != 2:
+        print(__doc__)
+        return 2
+    breaches = check(argv[1])
+    for b in breaches:
+        print(b)
+    print(f'layout: {len(breaches)} breaches')
+    return 1 if breaches else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv))
