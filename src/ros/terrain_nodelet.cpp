@@ -91,6 +91,11 @@ class TerrainNodelet : public nodelet::Nodelet {
       };
       hooks.progress_every = 30.0;
       hooks.prepared_soil_cache = prepared_soil_cache_;
+      // what the terrain is, for the report (the vehicle's description of it) before it prepares
+      hooks.described = [this](const TerrainDescription& d) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        description_ = d;
+      };
       std::unique_ptr<TerrainModel> model =
           LoadTerrainModel(scene.terrain_file, TerrainVehicleOf(VehicleSpec::Load(scene.vehicle_file)),
                            scene.terrain_overrides, hooks);
@@ -173,12 +178,16 @@ class TerrainNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     res.time = time_;
     res.served = served_;
+    res.model = description_.model;
+    res.file = description_.file;
+    res.cone_index_psi = description_.cone_index;
+    res.time_step = description_.time_step;
+    res.fidelity = description_.fidelity;
     if (!model_) {
       res.error = error_.empty() ? "the terrain is not prepared yet" : "the terrain could not start: " + error_;
       res.figures = "{}";
       return res;
     }
-    res.model = model_->description().model;
     ResultFile f("", "");
     model_->Describe(&f);
     // the figures alone: the schema's own keys (scene, kind, status, error) belong to the run
@@ -340,6 +349,7 @@ class TerrainNodelet : public nodelet::Nodelet {
   ros::ServiceServer report_;
   std::string frame_id_ = "odom", exchange_name_;
   std::string prepared_soil_cache_;  ///< ~prepared_soil_cache: the folder of prepared soils ("" none)
+  TerrainDescription description_;   ///< what the terrain is, once it has read its file
   double cloud_rate_ = 10.0, next_frame_ = 0.0, time_ = 0.0, surface_z_ = 0.0;
   std::vector<float> first_shown_;  ///< each particle's plastic strain when first shown (by ID)
   std::vector<WheelState> states_;

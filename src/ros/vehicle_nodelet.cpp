@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <string>
 #include <thread>
@@ -39,9 +40,11 @@ namespace {
 /// The terrain reached through the lock-step exchange.
 class ExchangeTerrainPort final : public TerrainPort {
  public:
+  /// `describe`: what the terrain is, asked of it once, right after the opening exchange (by then it
+  /// has read its file and is prepared); false and a reason when it cannot say.
   ExchangeTerrainPort(std::unique_ptr<ExchangeClient<WheelStates, WheelWrenches>> client, std::string frame,
-                      TerrainDescription description)
-      : client_(std::move(client)), frame_(std::move(frame)), description_(std::move(description)) {}
+                      std::function<bool(TerrainDescription*, std::string*)> describe)
+      : client_(std::move(client)), frame_(std::move(frame)), describe_(std::move(describe)) {}
   const TerrainDescription& description() const override { return description_; }
   void Exchange(long step, double t, double dt, const std::vector<WheelState>& states,
                 std::vector<WheelWrench>* wrenches) override {
@@ -58,6 +61,11 @@ class ExchangeTerrainPort final : public TerrainPort {
       throw SimulationError(e.what());
     }
     last_req = req;
+    if (!described_) {
+      std::string why;
+      if (!describe_(&description_, &why)) throw SimulationError("the terrain does not say what it is: " + why);
+      described_ = true;
+    }
   }
   void Leave(const std::string& why) { client_->Leave(why); }
   boost::shared_ptr<const WheelStates> last_req;
@@ -66,7 +74,9 @@ class ExchangeTerrainPort final : public TerrainPort {
  private:
   std::unique_ptr<ExchangeClient<WheelStates, WheelWrenches>> client_;
   std::string frame_;
-  TerrainDescription description_;  ///< of the scene's terrain file: the terrain nodelet runs the same
+  std::function<bool(TerrainDescription*, std::string*)> describe_;
+  TerrainDescription description_;  ///< the terrain nodelet's (its report), after the opening exchange
+  bool described_ = false;
 };
 
 /// The driver reached through the lock-step exchange.
@@ -147,18 +157,15 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
           std::make_unique<ExchangeClient<WheelStates, WheelWrenches>>(
               nh, transport, nh.resolveName("exchange/terrain"), "exchange/wheel_states", "exchange/wheel_wrenches",
               "terrain", timing),
-          world_frame_, DescribeTerrain(scene_.terrain_file, scene_.terrain_overrides));
+          world_frame_, [this](TerrainDescription* d, std::string* why) { return TerrainDescriptionOf(d, why); });
       driver_ = std::make_unique<ExchangeDriverPort>(std::make_unique<ExchangeClient<dem_mobility::DriverInput, dem_mobility::DriverCommand>>(
           nh, transport, nh.resolveName("exchange/driver"), "exchange/driver_input", "exchange/driver_command", "driver",
           timing));
       NODELET_INFO("vehicle '%s' (%d bodies) on %s, grade %.2f deg, exchange over %s",
                    sim_->vehicle().name().c_str(), sim_->vehicle().system().num_bodies() - 1, scene_.file.c_str(),
                    scene_.grade_deg, transport.c_str());
-      const TerrainDescription& d = terrain_->description();
-      if (d.time_step > 0.0)
-        NODELET_INFO("terrain '%s' (level '%s', cone index %.4g psi, its own step %.4g s): waiting up to %.0f s for "
-                     "it to be prepared",
-                     d.model.c_str(), d.fidelity.c_str(), d.cone_index, d.time_step, timing.startup_timeout);
+      NODELET_INFO("terrain from %s: waiting up to %.0f s for it to be ready (a DEM soil is prepared first)",
+                   scene_.terrain_file.c_str(), timing.startup_timeout);
     } catch (const std::exception& e) {
       Fail(std::string(e.what()));
       return;
@@ -246,10 +253,8 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
         // with the reason the exchange gave
         r.interrupted = true;
         interrupted_why_ = e.what();
-        try {
-          r.terrain = DescribeTerrain(scene_.terrain_file, scene_.terrain_overrides);
-        } catch (const std::exception&) {
-        }
+        std::string why;
+        TerrainDescriptionOf(&r.terrain, &why);  // (what the terrain had read, if it had)
       } else {
         r.error = e.what();
       }
@@ -404,25 +409,11 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
   /// (ROS shutting down on Ctrl-C, the terrain unloaded), from the terrain nodelet in this process
   /// (TerrainFiguresBoard: its figures now, or those of its last exchange once it has unloaded).
   YAML::Node TerrainFigures(std::string* error) {
-    ros::ServiceClient client = getNodeHandle().serviceClient<TerrainReport>("terrain/report");
     TerrainReport srv;
-    std::string unanswered;
-    // the terrain nodelet advertises it when it loads; one that is gone (unloaded, killed) is not
-    // waited for long
-    if (!ros::ok())
-      unanswered = "ROS is shutting down";
-    else if (!client.waitForExistence(ros::Duration(2.0)))
-      unanswered = "no terrain answers " + client.getService();
-    else if (!client.call(srv))
-      unanswered = client.getService() + " failed";
-    if (!unanswered.empty()) {
-      if (!TerrainFiguresBoard::Read(client.getService(), &srv.response)) {
-        *error = unanswered;
-        NODELET_WARN("the result goes without the terrain's own figures: %s", error->c_str());
-        return YAML::Node(YAML::NodeType::Map);
-      }
-      NODELET_INFO("the terrain's own figures (t = %.6g s) from the terrain nodelet in this process: %s",
-                   srv.response.time, unanswered.c_str());
+    const std::string service = AskTerrainReport(&srv.response, error);
+    if (!error->empty()) {
+      NODELET_WARN("the result goes without the terrain's own figures: %s", error->c_str());
+      return YAML::Node(YAML::NodeType::Map);
     }
     if (!srv.response.error.empty()) {
       *error = srv.response.error;
@@ -430,13 +421,57 @@ class VehicleNodelet : public nodelet::Nodelet, private CoSimObserver {
       try {
         const YAML::Node n = YAML::Load(srv.response.figures);
         if (n.IsMap()) return n;
-        *error = client.getService() + " answered no map of figures";
+        *error = service + " answered no map of figures";
       } catch (const YAML::Exception& e) {
-        *error = client.getService() + " answered malformed YAML: " + e.what();
+        *error = service + " answered malformed YAML: " + e.what();
       }
     }
     NODELET_WARN("the result goes without the terrain's own figures: %s", error->c_str());
     return YAML::Node(YAML::NodeType::Map);
+  }
+
+  /// What the terrain is (its description), from its report: false and `why` when it cannot say
+  /// (no answer, or it has not read its file yet).
+  bool TerrainDescriptionOf(TerrainDescription* d, std::string* why) {
+    TerrainReport srv;
+    AskTerrainReport(&srv.response, why);
+    if (why->empty() && srv.response.model.empty())
+      *why = srv.response.error.empty() ? "its report names no model" : srv.response.error;
+    if (!why->empty()) return false;
+    d->model = srv.response.model;
+    d->file = srv.response.file;
+    d->cone_index = srv.response.cone_index_psi;
+    d->time_step = srv.response.time_step;
+    d->fidelity = srv.response.fidelity;
+    return true;
+  }
+
+  /// The terrain nodelet's report, from its service terrain/report, or, when that cannot answer,
+  /// from TerrainFiguresBoard (see TerrainFigures); `unanswered` says why there is none. Returns
+  /// the service's name.
+  std::string AskTerrainReport(TerrainReport::Response* response, std::string* unanswered) {
+    ros::ServiceClient client = getNodeHandle().serviceClient<TerrainReport>("terrain/report");
+    TerrainReport srv;
+    std::string why;
+    // the terrain nodelet advertises it when it loads; one that is gone (unloaded, killed) is not
+    // waited for long
+    if (!ros::ok())
+      why = "ROS is shutting down";
+    else if (!client.waitForExistence(ros::Duration(2.0)))
+      why = "no terrain answers " + client.getService();
+    else if (!client.call(srv))
+      why = client.getService() + " failed";
+    if (!why.empty()) {
+      if (!TerrainFiguresBoard::Read(client.getService(), &srv.response)) {
+        *unanswered = why;
+        return client.getService();
+      }
+      NODELET_INFO("the terrain's report (t = %.6g s) from the terrain nodelet in this process: %s",
+                   srv.response.time, why.c_str());
+    }
+    unanswered->clear();
+    *response = srv.response;
+    return client.getService();
   }
 
   /// A setup error: said clearly, written to the result file when one is set, and the run ends.

@@ -45,13 +45,15 @@ class Ticker {
 };
 
 /// The result of a mobility run that stopped before it began (interrupted or failed while the
-/// terrain prepared): the terrain it was, no samples; the history's header is written.
+/// terrain prepared): the terrain it was (as it described itself once it had read its file), no
+/// samples; the history's header is written.
 ResultFile BeforeTheRun(const MobilityRunParams& p, const SceneRunOptions& o,
-                        std::chrono::steady_clock::time_point wall0, const std::string& status, const std::string& why) {
+                        std::chrono::steady_clock::time_point wall0, const std::string& status, const std::string& why,
+                        const TerrainDescription& terrain) {
   MobilityRunResult r;
   r.interrupted = status == "interrupted";
   if (!r.interrupted) r.error = why;
-  r.terrain = DescribeTerrain(p.terrain_file, p.terrain_overrides);
+  r.terrain = terrain;
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   std::printf("%s\n", why.c_str());
   if (!o.history_file.empty()) WriteMobilityHistory(r, o.history_file);
@@ -141,10 +143,13 @@ StartedRun StartMobilityRun(const YamlReader& reader, const MobilityRunParams& p
     std::printf("restarted from %s at t = %.3f s (step %ld; %.0f s of wall time before)\n", o.restart_file.c_str(),
                 s.restarted.driver_time, s.restarted.step, s.resume.r.wall_time);
   } else {
+    TerrainDescription described;  // (what the terrain is, once it has read its file)
+    described.file = p.terrain_file;
     try {
       PreparationHooks hooks;
       hooks.stop = [stop = o.stop] { return stop && stop->load(std::memory_order_relaxed); };
       hooks.prepared_soil_cache = o.prepared_soil_cache;
+      hooks.described = [&described](const TerrainDescription& d) { described = d; };
       if (!o.quiet)  // (a soil at a fine level prepares for minutes to hours)
         hooks.progress = [](const PreparationProgress& at) {
           std::printf("  preparing the terrain: %s\n", at.Line().c_str());
@@ -154,12 +159,12 @@ StartedRun StartMobilityRun(const YamlReader& reader, const MobilityRunParams& p
     } catch (const Interrupted& e) {
       // stopped while the terrain prepared, before the run began: the result and the history (its
       // header) say so, the result with how far the preparation had come
-      s.before = BeforeTheRun(p, o, wall0, "interrupted", e.what());
+      s.before = BeforeTheRun(p, o, wall0, "interrupted", e.what(), described);
       return s;
     } catch (const SimulationError& e) {
       // a numerical failure in the terrain's preparation or the opening exchange (a watchdog): the
       // result says so, as a failure during a run does
-      s.before = BeforeTheRun(p, o, wall0, "error", e.what());
+      s.before = BeforeTheRun(p, o, wall0, "error", e.what(), described);
       return s;
     }
   }

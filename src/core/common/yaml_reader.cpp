@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 namespace dem_mobility::core {
 
@@ -266,12 +267,23 @@ std::string YamlReader::ResolvePath(const std::string& relative) const {
   return Dirname(file_) + "/" + relative;
 }
 
+namespace {
+/// Names a thing had before it got its one name (a launch argument or key given the old way is
+/// refused, the message naming the new one).
+const std::pair<const char*, const char*> kRenamed[] = {
+    {"f", "cohesion_factor"}, {"mu", "friction"}, {"grade", "grade_deg"}, {"ci", "cone_index"},
+    {"ci_psi", "cone_index"}, {"requested_ci", "cone_index"}, {"cone_index_psi", "cone_index"}};
+}  // namespace
+
 void YamlReader::Finish() const {
   if (!node_.IsMap()) return;
   std::string unknown;
   for (const auto& kv : node_) {
     const std::string k = KeyText(kv.first);
-    if (!used_->count(k)) unknown += (unknown.empty() ? "" : ", ") + k;
+    if (used_->count(k)) continue;
+    unknown += (unknown.empty() ? "" : ", ") + k;
+    for (const auto& [old_name, name] : kRenamed)
+      if (k == old_name) unknown += std::string(" (now ") + name + ")";
   }
   if (!unknown.empty()) Fail("", "unknown key(s): " + unknown);
 }

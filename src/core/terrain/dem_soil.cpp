@@ -289,6 +289,7 @@ std::unique_ptr<TerrainModel> MakeDemSoilTerrain(const YamlReader& y, const Terr
                                                  const PreparationHooks& hooks) {
   InputFileRecord inputs;
   const DemSoilParams p = ReadDemSoilFor(y, vehicle);
+  if (hooks.described) hooks.described(SoilDescription(p));
   if (hooks.prepared_soil_cache.empty()) return std::make_unique<DemSoilTerrain>(p, vehicle.tire, vehicle.wheels, hooks);
   const std::string path = PreparedSoilCache(hooks.prepared_soil_cache).PathOf(y, inputs.Files(), vehicle);
   std::unique_ptr<DemSoilTerrain> t;

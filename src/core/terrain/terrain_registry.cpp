@@ -52,7 +52,17 @@ const TerrainKind& FindTerrainKind(const YamlReader& y) {
 std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
                                                const std::vector<std::string>& overrides, const PreparationHooks& hooks) {
   const YamlReader y = YamlReader::LoadWithOverrides(terrain_file, overrides);
-  return FindTerrainKind(y).make(y, vehicle, hooks);
+  // a model that prepares for long says what it is before it does; any other once it is built
+  bool told = false;
+  PreparationHooks h = hooks;
+  if (hooks.described)
+    h.described = [&told, &hooks](const TerrainDescription& d) {
+      told = true;
+      hooks.described(d);
+    };
+  std::unique_ptr<TerrainModel> model = FindTerrainKind(y).make(y, vehicle, h);
+  if (hooks.described && !told) hooks.described(model->description());
+  return model;
 }
 
 void CheckTerrainModel(const YamlReader& y, const TerrainVehicle& vehicle) { FindTerrainKind(y).check(y, vehicle); }

@@ -97,12 +97,15 @@ struct PreparationProgress {
 /// How a long preparation goes. `stop` (may be empty): called every step; once it returns true the
 /// preparation stops within a step and throws Interrupted saying where it was. `progress` (may be
 /// empty): called when a phase begins, about every `progress_every` wall seconds within one, and
-/// when the preparation is done. `prepared_soil_cache` (may be empty): the folder of prepared
-/// soils (PreparedSoilCache) a soil is read from instead of prepared, and kept in once prepared.
+/// when the preparation is done. `described` (may be empty): called once, as soon as the terrain
+/// has read its file and knows what it is (before a long preparation), with its description.
+/// `prepared_soil_cache` (may be empty): the folder of prepared soils (PreparedSoilCache) a soil is
+/// read from instead of prepared, and kept in once prepared.
 struct PreparationHooks {
   std::function<bool()> stop;
   std::function<void(const PreparationProgress&)> progress;
   double progress_every = 10.0;  ///< [s] of wall time
+  std::function<void(const TerrainDescription&)> described;
   std::string prepared_soil_cache;
 };
 
