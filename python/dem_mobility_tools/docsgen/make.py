@@ -8,6 +8,7 @@ writes nothing and exits 1 naming each doc and table that differs from what it w
 `--figures` also redraws the plots whose data is committed (matplotlib, Agg).
 """
 import argparse
+import datetime
 import glob
 import os
 import re
@@ -57,6 +58,8 @@ def load_tables(root):
         name = _need(t, 'table', rel, str)
         _need(t, 'doc', rel, str)
         prov = _need(t, 'provenance', rel, dict)
+        if isinstance(prov.get('date'), datetime.date):
+            prov['date'] = prov['date'].isoformat()  # YAML reads a bare date as a date
         for key in ('commit', 'machine', 'date', 'command'):
             _need(prov, key, rel + ': provenance', str)
         rows = _need(t, 'rows', rel, list)
