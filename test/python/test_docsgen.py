@@ -93,6 +93,35 @@ class HandEdits(RepoCopy):
         self.assertIn('docs/data/performance-doe_map.yaml: provenance: missing key commit', err)
 
 
+class Figures(RepoCopy):
+    """--figures redraws every plot of committed data, each from its file."""
+
+    def setUp(self):
+        super().setUp()
+        shutil.copytree(os.path.join(ROOT, 'config', 'calibration'), os.path.join(self.tmp, 'config', 'calibration'))
+
+    def test_every_plot_is_drawn_and_is_a_png_the_docs_show(self):
+        rc, err = run(['--root', self.tmp, '--figures'])
+        self.assertEqual(rc, 0, err)
+        from dem_mobility_tools.docsgen import figures
+        with contextlib.redirect_stdout(io.StringIO()):
+            drawn = figures.draw_all(self.tmp)
+        self.assertEqual(len(drawn), 7)
+        docs = ''.join(open(os.path.join(ROOT, 'docs', f)).read()
+                       for f in os.listdir(os.path.join(ROOT, 'docs')) if f.endswith('.md'))
+        for path in drawn:
+            with open(path, 'rb') as f:
+                self.assertEqual(f.read(8), b'\x89PNG\r\n\x1a\n', path)
+            self.assertIn('(' + os.path.basename(path) + ')', docs, 'no doc shows ' + path)
+
+    def test_a_broken_data_file_is_refused_naming_it(self):
+        self.edit('docs/data/single-wheel-slip-sweep.yaml', "dp_w_std: 0.206 (0.065)", "dp_w_std: about a fifth")
+        from dem_mobility_tools.docsgen import figures
+        with self.assertRaises(make.DocsError) as e:
+            figures.wheel_sweep(self.tmp)
+        self.assertIn('docs/data/single-wheel-slip-sweep.yaml: dp_w_std', str(e.exception))
+
+
 class Status(unittest.TestCase):
     """met / not met follow from the goal and the figure, for every value of it."""
 
