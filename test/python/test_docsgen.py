@@ -1,0 +1,152 @@
+"""dm-docs: the docs' generated tables match docs/data/, and a hand edit is caught."""
+import contextlib
+import io
+import os
+import shutil
+import tempfile
+import unittest
+
+from dem_mobility_tools.docsgen import make
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..', '..'))
+
+
+def run(argv):
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        rc = make.main(argv)
+    return rc, err.getvalue()
+
+
+class RepoCopy(unittest.TestCase):
+    """A temporary copy of the parts of the checkout the generator reads."""
+
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix='docsgen-')
+        for d in ('docs', 'launch'):
+            shutil.copytree(os.path.join(ROOT, d), os.path.join(self.tmp, d),
+                            ignore=shutil.ignore_patterns('*.png'))
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp)
+
+    def edit(self, rel, old, new):
+        path = os.path.join(self.tmp, rel)
+        with open(path) as f:
+            text = f.read()
+        self.assertEqual(text.count(old), 1, '{!r} not once in {}'.format(old, rel))
+        with open(path, 'w') as f:
+            f.write(text.replace(old, new))
+
+
+class TheRepo(unittest.TestCase):
+    def test_docs_are_what_the_data_generate(self):
+        rc, err = run(['--root', ROOT, '--check'])
+        self.assertEqual(rc, 0, err)
+
+    def test_every_data_file_has_its_provenance(self):
+        tables = make.load_tables(ROOT)
+        self.assertTrue(tables)
+        for t in tables.values():
+            for key in ('commit', 'machine', 'date', 'command'):
+                self.assertTrue(t['provenance'][key].strip(), '{}: provenance {}'.format(t['_file'], key))
+
+
+class HandEdits(RepoCopy):
+    def test_a_hand_edited_table_fails_the_check_naming_doc_and_table(self):
+        self.edit('docs/performance.md', '10.087 / 20.249', '10.087 / 21.249')  # bed (a)'s 2-thread rate
+        rc, err = run(['--root', self.tmp, '--check'])
+        self.assertEqual(rc, 1)
+        self.assertIn('docs/performance.md: performance/dem_step', err)
+
+    def test_regenerating_undoes_the_edit(self):
+        self.edit('docs/performance.md', '10.087 / 20.249', '10.087 / 21.249')
+        self.assertEqual(run(['--root', self.tmp])[0], 0)
+        self.assertEqual(run(['--root', self.tmp, '--check'])[0], 0)
+        with open(os.path.join(self.tmp, 'docs', 'performance.md')) as f, \
+                open(os.path.join(ROOT, 'docs', 'performance.md')) as g:
+            self.assertEqual(f.read(), g.read())
+
+    def test_a_hand_edited_launch_page_fails_the_check(self):
+        self.edit('docs/launch.md', '| `rate` | `1.0` |', '| `rate` | `2.0` |')
+        rc, err = run(['--root', self.tmp, '--check'])
+        self.assertEqual(rc, 1)
+        self.assertIn('docs/launch.md', err)
+
+    def test_a_launch_argument_without_doc_is_refused_naming_file_and_argument(self):
+        self.edit('launch/replay.launch', ' doc="playback rate"', '')
+        rc, err = run(['--root', self.tmp, '--check'])
+        self.assertEqual(rc, 1)
+        self.assertIn('launch/replay.launch: arg rate: no doc=', err)
+
+    def test_a_marker_without_data_is_refused(self):
+        with open(os.path.join(self.tmp, 'docs', 'performance.md'), 'a') as f:
+            f.write('\n<!-- generated: performance/nothing -->\n<!-- end generated -->\n')
+        rc, err = run(['--root', self.tmp, '--check'])
+        self.assertEqual(rc, 1)
+        self.assertIn('performance/nothing', err)
+
+    def test_a_data_file_without_provenance_is_refused_naming_file_and_key(self):
+        self.edit('docs/data/performance-doe_map.yaml', '  commit: fc1a930\n', '')
+        rc, err = run(['--root', self.tmp, '--check'])
+        self.assertEqual(rc, 1)
+        self.assertIn('docs/data/performance-doe_map.yaml: provenance: missing key commit', err)
+
+
+class Figures(RepoCopy):
+    """--figures redraws every plot of committed data, each from its file."""
+
+    def setUp(self):
+        super().setUp()
+        shutil.copytree(os.path.join(ROOT, 'config', 'calibration'), os.path.join(self.tmp, 'config', 'calibration'))
+
+    def test_every_plot_is_drawn_and_is_a_png_the_docs_show(self):
+        rc, err = run(['--root', self.tmp, '--figures'])
+        self.assertEqual(rc, 0, err)
+        from dem_mobility_tools.docsgen import figures
+        with contextlib.redirect_stdout(io.StringIO()):
+            drawn = figures.draw_all(self.tmp)
+        self.assertEqual(len(drawn), 7)
+        docs = ''.join(open(os.path.join(ROOT, 'docs', f)).read()
+                       for f in os.listdir(os.path.join(ROOT, 'docs')) if f.endswith('.md'))
+        for path in drawn:
+            with open(path, 'rb') as f:
+                self.assertEqual(f.read(8), b'\x89PNG\r\n\x1a\n', path)
+            self.assertIn('(' + os.path.basename(path) + ')', docs, 'no doc shows ' + path)
+
+    def test_a_broken_data_file_is_refused_naming_it(self):
+        self.edit('docs/data/single-wheel-slip-sweep.yaml', "dp_w_std: 0.206 (0.065)", "dp_w_std: about a fifth")
+        from dem_mobility_tools.docsgen import figures
+        with self.assertRaises(make.DocsError) as e:
+            figures.wheel_sweep(self.tmp)
+        self.assertIn('docs/data/single-wheel-slip-sweep.yaml: dp_w_std', str(e.exception))
+
+
+class Status(unittest.TestCase):
+    """met / not met follow from the goal and the figure, for every value of it."""
+
+    def status(self, **row):
+        row.setdefault('what', 'x')
+        return make._status(row, 'test')[1]
+
+    def test_bounds(self):
+        self.assertEqual(self.status(value=1.0, goal={'min': 1.0}), 'met')
+        self.assertEqual(self.status(value=0.99, goal={'min': 1.0}), '**not met**')
+        self.assertEqual(self.status(value=5.0, goal={'max': 5}), 'met')
+        self.assertEqual(self.status(value=5.01, goal={'max': 5}), '**not met**')
+
+    def test_a_range_meets_the_goal_only_if_all_of_it_does(self):
+        self.assertEqual(self.status(range=[3.4, 4.7], goal={'max': 5}), 'met')
+        self.assertEqual(self.status(range=[3.4, 5.1], goal={'max': 5}), '**not met**')
+        self.assertEqual(self.status(value=[1.95, 1.89], goal={'min': 1.9}), '**not met**')
+
+    def test_no_goal_no_status(self):
+        self.assertEqual(self.status(value=3), '')
+
+    def test_a_text_value_needs_a_figure_to_compare(self):
+        with self.assertRaises(make.DocsError):
+            self.status(value='12-14 us', goal={'max': 15})
+
+
+if __name__ == '__main__':
+    unittest.main()
