@@ -2,7 +2,7 @@
 # Runs a scene with rviz under a virtual display (Xvfb) and saves what a user sees:
 #   ./scripts/rviz_screenshot.sh [OUT.png] [seconds into the run] [LAUNCH.launch] [roslaunch args...]
 # LAUNCH defaults to road_slope.launch (run paced at real time, rviz on). Examples:
-#   ./scripts/rviz_screenshot.sh docs/rviz-cone.png 40 cone_penetrometer.launch fidelity:=tiny f:=5
+#   ./scripts/rviz_screenshot.sh docs/rviz-cone.png 40 cone_penetrometer.launch fidelity:=tiny cohesion_factor:=5
 #   ./scripts/rviz_screenshot.sh docs/rviz-cone-replay.png 8 replay.launch bag:=$HOME/.ros/dem_mobility/cone_penetrometer.bag view:=cone
 #   ./scripts/rviz_screenshot.sh docs/rviz-soil-slope.png 25 replay.launch bag:=$HOME/.ros/dem_mobility/soil_slope.bag view:=soil_slope rate:=0.1
 #     (the soil scene: its preparation takes minutes, so the picture comes from its bag)

@@ -57,7 +57,7 @@ class ConeTopics final : public RigTopics {
       m->tip_depth = c.depth;
       m->speed = c.speed;
       m->force = c.force;
-      m->cone_index_psi = c.ci_psi;
+      m->cone_index_psi = c.cone_index_psi;
       penetration_.publish(m);
     }
   }
@@ -72,8 +72,8 @@ class ConeTopics final : public RigTopics {
     m.fidelity = r.level;
     m.cohesion_factor = r.cohesion_factor;
     m.friction = r.friction;
-    m.cone_index_psi = r.ci_psi;
-    m.cone_index_std_psi = r.ci_std_psi;
+    m.cone_index_psi = r.cone_index_psi;
+    m.cone_index_std_psi = r.cone_index_std_psi;
     m.cone_speed_min = r.speed_min;
     m.cone_speed_max = r.speed_max;
     m.particles = r.particles;

@@ -289,7 +289,7 @@ ResultFile RunConeScene(const YamlReader& reader, const SceneRunOptions& o) {
               r.density_poured, r.density_consolidated, r.lid_pressure_reached * 1e-3);
   std::printf("cone_index: %.2f psi (std %.2f, trend %.1f psi/m over tip depths %.3g-%.3g m, %d samples); cone speed "
               "%.4f-%.4f m/s\n",
-              r.ci_psi, r.ci_std_psi, r.ci_trend_psi_per_m, p.level.ci_from, p.level.ci_to, r.window_samples,
+              r.cone_index_psi, r.cone_index_std_psi, r.cone_index_trend_psi_per_m, p.level.ci_from, p.level.ci_to, r.window_samples,
               r.speed_min, r.speed_max);
   std::printf("run: %ld steps, %.3f s simulated (%.3f s preparation) in %.1f s wall\n", r.steps, r.sim_time,
               r.prep_time, r.wall_time);

@@ -64,7 +64,7 @@ TEST(ConeConfig, ConeIndexTurnsIntoFThroughTheTable) {
   const ConeParams p = Cone({"cone_index=" + std::to_string(ci)});
   EXPECT_DOUBLE_EQ(p.strength.cohesion_factor, cal.CohesionFactor(ci));
   EXPECT_DOUBLE_EQ(p.soil.cohesion_factor, p.strength.cohesion_factor);
-  EXPECT_DOUBLE_EQ(p.strength.requested_ci, ci);
+  EXPECT_DOUBLE_EQ(p.strength.requested_cone_index_psi, ci);
   ASSERT_TRUE(p.strength.calibration);
   EXPECT_EQ(p.strength.calibration->file, cal.file);
   // the result says which table it used, for which particles, and the table's error
@@ -314,7 +314,7 @@ TEST(ConePenetrometer, ConeIndexRisesWithFWithinTheCalibrationBand) {
   for (int k = 0; k < 2; ++k) {
     ASSERT_TRUE(r[k].error.empty()) << r[k].error;
     const double predicted = cal.ConeIndex(fs[k]);
-    EXPECT_NEAR(r[k].ci_psi, predicted, std::max(2.0 * cal.band, 0.05) * predicted) << "f = " << fs[k];
+    EXPECT_NEAR(r[k].cone_index_psi, predicted, std::max(2.0 * cal.band, 0.05) * predicted) << "f = " << fs[k];
     // the PID: every 10 ms sample past the approach (0.4 m/s down to approach_depth, then 0.1 m/s,
     // from a particle diameter further on) within 5 % of the cone's speed
     ASSERT_DOUBLE_EQ(level.level.cone_speed, 0.1);
@@ -330,7 +330,7 @@ TEST(ConePenetrometer, ConeIndexRisesWithFWithinTheCalibrationBand) {
     EXPECT_NEAR(r[k].lid_pressure_reached, 33.3e3, 0.1 * 33.3e3) << "f = " << fs[k];
     EXPECT_GT(r[k].density_consolidated, r[k].density_poured) << "f = " << fs[k];
   }
-  EXPECT_GT(r[1].ci_psi - r[0].ci_psi, 2.0 * (r[0].ci_std_psi + r[1].ci_std_psi));
+  EXPECT_GT(r[1].cone_index_psi - r[0].cone_index_psi, 2.0 * (r[0].cone_index_std_psi + r[1].cone_index_std_psi));
 }
 
 // Piston-cylinder compression (fig. 9): the bulk density rises with the pressure, and most of the

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -18,6 +19,7 @@
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/mobility/mobility_result.h"
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
+#include "dem_mobility/core/scenes/single_wheel.h"
 #include "dem_mobility/core/terrain/dem_soil.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle.h"
@@ -298,17 +300,39 @@ TEST(Config, TheFuzzersFindingsStayFixed) {
 // the other, the override's takes its place (an f given on the command line to the patch, whose
 // file names CI 100, was dropped without a word before); both in one place is refused, naming the
 // file and the key.
+// A thing has one name: a key given under a name it had before (the launch files' f:= and mu:=
+// reach the scene as the keys f and mu) is refused, the message naming the one name.
+TEST(Config, AKeyUnderAnOldNameIsRefusedNamingItsOneName) {
+  const std::string cone = DM_CONFIG_DIR "/scenes/cone_penetrometer.yaml";
+  const std::string wheel = DM_CONFIG_DIR "/scenes/single_wheel.yaml";
+  const std::string road = DM_CONFIG_DIR "/scenes/road_slope.yaml";
+  const auto refused = [](const std::function<void()>& read, const std::string& expected) {
+    try {
+      read();
+      ADD_FAILURE() << "accepted; expected: " << expected;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused([&] { ConeParams::Read(YamlReader::LoadWithOverrides(cone, {"f=2"})); }, "f (now cohesion_factor)");
+  refused([&] { SingleWheelParams::Read(YamlReader::LoadWithOverrides(wheel, {"mu=0.2"})); }, "mu (now friction)");
+  refused([&] { MobilityRunParams::Read(YamlReader::LoadWithOverrides(road, {"grade=12"})); }, "grade (now grade_deg)");
+  // the one names are taken
+  EXPECT_DOUBLE_EQ(ConeParams::Read(YamlReader::LoadWithOverrides(cone, {"cohesion_factor=2"})).strength.cohesion_factor, 2.0);
+  EXPECT_DOUBLE_EQ(SingleWheelParams::Read(YamlReader::LoadWithOverrides(wheel, {"friction=0.2"})).bin.friction, 0.2);
+}
+
 TEST(Config, AnOverriddenSoilStrengthTakesThePlaceOfTheFilesOther) {
   const std::string patch = DM_CONFIG_DIR "/terrains/soil_patch.yaml";  // cone_index: 100, coarse
   auto read = [&](const std::vector<std::string>& o) { return DemSoilParams::Read(YamlReader::LoadWithOverrides(patch, o)); };
   // the file's CI 100 through the coarse table (the row [100, 7.5962])
   const DemSoilParams file = read({});
-  EXPECT_DOUBLE_EQ(file.strength.requested_ci, 100.0);
+  EXPECT_DOUBLE_EQ(file.strength.requested_cone_index_psi, 100.0);
   EXPECT_NEAR(file.strength.cohesion_factor, 7.5962, 1e-9);
   // f 3 by an override: f 3, no requested CI; CI 50 by an override: the table's f (2.5953)
   const DemSoilParams f3 = read({"cohesion_factor=3"});
   EXPECT_DOUBLE_EQ(f3.strength.cohesion_factor, 3.0);
-  EXPECT_TRUE(std::isnan(f3.strength.requested_ci));
+  EXPECT_TRUE(std::isnan(f3.strength.requested_cone_index_psi));
   EXPECT_NEAR(read({"cone_index=50"}).strength.cohesion_factor, 2.5953, 1e-9);
   // both by overrides: refused
   try {

@@ -35,7 +35,7 @@ class SingleWheelRun(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.mkdtemp(prefix='dm_single_wheel_')
-        cls.code, cls.log, cls.bag = run(cls.tmp, 'ok', 'f:=1.5', 'slip:=0.2', 'cloud_rate:=10')
+        cls.code, cls.log, cls.bag = run(cls.tmp, 'ok', 'cohesion_factor:=1.5', 'slip:=0.2', 'cloud_rate:=10')
         cls.res = load_result(cls.bag)
         cls.counts, cls.msgs = {}, {}
         with rosbag.Bag(cls.bag) as b:

@@ -130,7 +130,7 @@ std::string ConePenetrometer::phase() const {
 std::string ConePenetrometer::StatusLine() const {
   char buf[160];
   if (penetrating()) {
-    const double ci = samples_.empty() ? 0.0 : samples_.back().ci_psi;
+    const double ci = samples_.empty() ? 0.0 : samples_.back().cone_index_psi;
     std::snprintf(buf, sizeof buf, "t %.2f s  %s  tip depth %.3f / %.3f m  CI %.1f psi", dem_->time(),
                   phase().c_str(), tip_depth(), p_.level.ci_to, ci);
   } else {
@@ -265,7 +265,7 @@ void ConePenetrometer::Sample() {
   c.depth = tip_depth();
   c.speed = (sample_z_ - z_tip_) / (s.time() - sample_t_);
   c.force = sample_force_ / sample_steps_;
-  c.ci_psi = c.force / p_.BaseArea() / kPsi;
+  c.cone_index_psi = c.force / p_.BaseArea() / kPsi;
   samples_.push_back(c);
   sample_force_ = 0.0;
   sample_steps_ = 0;
@@ -287,7 +287,7 @@ ConeResult ConePenetrometer::Result() const {
   r.particles = dem_->num_alive();
   r.cohesion_factor = p_.strength.cohesion_factor;
   r.friction = p_.friction;
-  r.requested_ci = p_.strength.requested_ci;
+  r.requested_cone_index_psi = p_.strength.requested_cone_index_psi;
   r.surface_height = surface_;
   const double mass = r.particles * dem_->mass(), area = M_PI * R * R;
   if (prep_->height_poured() > 0.0) r.density_poured = mass / (area * prep_->height_poured());
@@ -308,18 +308,18 @@ ConeResult ConePenetrometer::Result() const {
     if (c.depth < p_.level.ci_from || c.depth > p_.level.ci_to + 1e-9) continue;
     n += 1;
     sx += c.depth;
-    sy += c.ci_psi;
+    sy += c.cone_index_psi;
     sxx += c.depth * c.depth;
-    sxy += c.depth * c.ci_psi;
-    syy += c.ci_psi * c.ci_psi;
+    sxy += c.depth * c.cone_index_psi;
+    syy += c.cone_index_psi * c.cone_index_psi;
   }
   if (r.speed_min > r.speed_max) r.speed_min = r.speed_max = 0.0;
   r.window_samples = static_cast<int>(n);
   if (n > 0) {
-    r.ci_psi = sy / n;
-    r.ci_std_psi = std::sqrt(std::max(0.0, syy / n - r.ci_psi * r.ci_psi));
+    r.cone_index_psi = sy / n;
+    r.cone_index_std_psi = std::sqrt(std::max(0.0, syy / n - r.cone_index_psi * r.cone_index_psi));
     const double vx = sxx / n - (sx / n) * (sx / n);
-    if (n > 1 && vx > 0.0) r.ci_trend_psi_per_m = (sxy / n - (sx / n) * (sy / n)) / vx;
+    if (n > 1 && vx > 0.0) r.cone_index_trend_psi_per_m = (sxy / n - (sx / n) * (sy / n)) / vx;
   }
   r.prep_time = penetrating() ? t0_ : dem_->time();
   r.sim_time = dem_->time();
@@ -337,11 +337,11 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
   f.Set("fidelity", r.level);
   f.Set("cohesion_factor", r.cohesion_factor);
   f.Set("friction", r.friction);
-  if (std::isfinite(r.requested_ci)) f.Set("requested_cone_index_psi", r.requested_ci);
+  if (std::isfinite(r.requested_cone_index_psi)) f.Set("requested_cone_index_psi", r.requested_cone_index_psi);
   if (p.strength.calibration) p.strength.calibration->Describe(&f);  // which table f came from, and its error
-  f.Set("cone_index_psi", r.ci_psi);
-  f.Set("cone_index_std_psi", r.ci_std_psi);
-  f.Set("cone_index_trend_psi_per_m", r.ci_trend_psi_per_m);
+  f.Set("cone_index_psi", r.cone_index_psi);
+  f.Set("cone_index_std_psi", r.cone_index_std_psi);
+  f.Set("cone_index_trend_psi_per_m", r.cone_index_trend_psi_per_m);
   f.SetFlow("ci_window", {p.level.ci_from, p.level.ci_to});
   f.Set("window_samples", r.window_samples);
   f.Set("cone_speed_min", r.speed_min);
@@ -373,9 +373,9 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
     depth.push_back(c.depth);
     speed.push_back(c.speed);
     force.push_back(c.force);
-    ci.push_back(c.ci_psi);
+    ci.push_back(c.cone_index_psi);
   }
-  f.SetColumns("history", {{"t", t}, {"tip_depth", depth}, {"speed", speed}, {"force", force}, {"ci_psi", ci}});
+  f.SetColumns("history", {{"t", t}, {"tip_depth", depth}, {"speed", speed}, {"force", force}, {"cone_index_psi", ci}});
   return f;
 }
 

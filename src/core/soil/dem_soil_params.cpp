@@ -105,7 +105,7 @@ void DemSoilParams::Describe(ResultFile* r) const {
   r->Set("particle_diameter", level.particle_diameter);
   r->Set("cohesion_factor", strength.cohesion_factor);
   r->Set("friction", friction);
-  if (std::isfinite(strength.requested_ci)) r->Set("requested_cone_index_psi", strength.requested_ci);
+  if (std::isfinite(strength.requested_cone_index_psi)) r->Set("requested_cone_index_psi", strength.requested_cone_index_psi);
   const double ci = strength.ConeIndex();
   if (std::isfinite(ci))
     r->Set("cone_index_psi", ci);

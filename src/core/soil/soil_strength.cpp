@@ -32,11 +32,11 @@ SoilStrength SoilStrength::Read(const YamlReader& y, double particle_diameter, d
   if (y.Has("calibration")) s.calibration_file = y.ResolvePath(y.String("calibration"));
   const bool by_ci = SoilStrengthByConeIndex(y);  // (the one an override gives, where both are there)
   if (by_ci) {
-    s.requested_ci = y.Positive("cone_index");
+    s.requested_cone_index_psi = y.Positive("cone_index");
     if (s.calibration_file.empty()) y.Fail("calibration", "is needed to turn cone_index into f");
     try {
       auto table = std::make_shared<CiCalibration>(CiCalibration::LoadFor(s.calibration_file, particle_diameter, friction));
-      s.cohesion_factor = table->CohesionFactor(s.requested_ci);
+      s.cohesion_factor = table->CohesionFactor(s.requested_cone_index_psi);
       s.calibration = std::move(table);
     } catch (const ConfigError& e) {
       y.Fail("cone_index", e.what());
@@ -62,7 +62,7 @@ SoilStrength SoilStrength::Read(const YamlReader& y, double particle_diameter, d
 }
 
 double SoilStrength::ConeIndex() const {
-  if (std::isfinite(requested_ci)) return requested_ci;
+  if (std::isfinite(requested_cone_index_psi)) return requested_cone_index_psi;
   if (!calibration) return std::numeric_limits<double>::quiet_NaN();
   try {
     return calibration->ConeIndex(cohesion_factor);

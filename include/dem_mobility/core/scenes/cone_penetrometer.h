@@ -79,19 +79,19 @@ struct ConeSample {
   double depth = 0.0;   ///< tip depth below the surface [m]
   double speed = 0.0;   ///< downward [m/s]
   double force = 0.0;   ///< the soil's upward force on the penetrometer [N]
-  double ci_psi = 0.0;  ///< force / base area [psi]
+  double cone_index_psi = 0.0;  ///< force / base area [psi]
 };
 
 struct ConeResult {
   std::string level;
   int particles = 0;
-  double cohesion_factor = 0.0, friction = 0.0, requested_ci = std::numeric_limits<double>::quiet_NaN();
+  double cohesion_factor = 0.0, friction = 0.0, requested_cone_index_psi = std::numeric_limits<double>::quiet_NaN();
   double surface_height = 0.0;       ///< soil surface after the preparation [m]
   double density_poured = 0.0, density_consolidated = 0.0;  ///< bulk [kg/m^3]
   double lid_pressure_reached = 0.0; ///< mean over the hold [Pa]
-  double ci_psi = 0.0;               ///< mean over the window: the cone index
-  double ci_std_psi = 0.0;           ///< scatter of the samples in the window
-  double ci_trend_psi_per_m = 0.0;   ///< slope of CI over tip depth in the window
+  double cone_index_psi = 0.0;               ///< mean over the window: the cone index
+  double cone_index_std_psi = 0.0;           ///< scatter of the samples in the window
+  double cone_index_trend_psi_per_m = 0.0;   ///< slope of CI over tip depth in the window
   double speed_min = 0.0, speed_max = 0.0;  ///< of the samples in the soil (tip below one diameter and past the approach)
   int window_samples = 0;
   std::vector<ConeSample> samples;

@@ -21,7 +21,7 @@ struct SoilStrength {
 
   double cohesion_factor = 1.0;  ///< f
   /// [psi] the cone index asked for (`cone_index`), NaN when f was given (`cohesion_factor`)
-  double requested_ci = std::numeric_limits<double>::quiet_NaN();
+  double requested_cone_index_psi = std::numeric_limits<double>::quiet_NaN();
   std::string calibration_file;  ///< `calibration`: a table or a directory of tables ("" : none)
   /// The table f came from, or (f given, `name_ci_of_f`) the one that names f's cone index; none
   /// when there is no table at this particle size and friction.
