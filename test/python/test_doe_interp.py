@@ -1,17 +1,15 @@
-"""Unit tests of scripts/dm_doe/interp.py: bilinear interpolation is exact on a plane (and on the
+"""Unit tests of dem_mobility_tools.doe.interp: bilinear interpolation is exact on a plane (and on the
 bilinear a + b g + c CI + d g CI inside each table cell), NaN outside (the map timing is a benchmark).
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import os
-import sys
 import unittest
 
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import interp, plan  # noqa: E402
+from dem_mobility_tools.doe import interp, plan
 
 G, C = np.array(plan.PAPER_GRADES), np.array(plan.PAPER_CONE_INDICES)   # uneven CI spacing
 

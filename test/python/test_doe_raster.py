@@ -1,23 +1,22 @@
-"""Unit tests of scripts/dm_doe/raster.py (GDAL): slopes against gdaldem on the shipped raster,
+"""Unit tests of dem_mobility_tools.doe.raster (GDAL): slopes against gdaldem on the shipped raster,
 per-cell maximum slope and minimum cone index on planes (exact), the GeoTIFF keeping its CRS and
 geotransform, the CI generator, and the refusals (no CRS, bad cell size).
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import math
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import unittest
 
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import raster  # noqa: E402
-from osgeo import gdal, osr  # noqa: E402
+from osgeo import gdal, osr
+
+from dem_mobility_tools.doe import raster
 
 DATA = os.path.join(os.path.dirname(ROOT), 'shared', 'data')
 ST_HELENS = os.path.join(DATA, 'mount_st_helens_30m_utm10n_nad27.tif')
