@@ -44,6 +44,18 @@ class Bilinear(unittest.TestCase):
                                   clamp_ci=True)
         np.testing.assert_array_equal(clamped, [np.nan, np.nan, 2.0])
 
+    def test_a_hand_computed_value(self):
+        # grades 0, 10 and CI 100, 200; at grade 2.5 (t 0.25) and CI 175 (u 0.75):
+        # 0.75 * 0.25 * 1 + 0.25 * 0.25 * 5 + 0.75 * 0.75 * 3 + 0.25 * 0.75 * 11 = 4.25 (exact in binary)
+        out = interp.bilinear([0.0, 10.0], [100.0, 200.0], [[1.0, 3.0], [5.0, 11.0]], np.array([2.5]),
+                              np.array([175.0]))
+        self.assertEqual(out[0], 4.25)
+
+    def test_a_one_cell_table_holds_its_value_at_its_point_only(self):
+        out = interp.bilinear([12.0], [30.0], [[2.0]], np.array([12.0, 12.0, 12.5, np.nan]),
+                              np.array([30.0, 31.0, 30.0, 30.0]))
+        np.testing.assert_array_equal(out, [2.0, np.nan, np.nan, np.nan])
+
     def test_a_single_grade_interpolates_along_ci(self):
         out = interp.bilinear([12.0], [30.0, 50.0], [[2.0, 6.0]], np.array([12.0, 12.0]), np.array([40.0, 50.0]))
         np.testing.assert_allclose(out, [4.0, 6.0])

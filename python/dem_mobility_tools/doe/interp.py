@@ -1,5 +1,6 @@
 """Bilinear interpolation of a speed table over (grade, cone index) at every cell of a map
-(paper section 5, step 2), vectorised with numpy: a 1100 x 1100 map is a handful of array passes.
+(paper section 5, step 2): scipy's RegularGridInterpolator (linear), a 1100 x 1100 map in a
+handful of array passes.
 
 The table is speed[i][j] at grades[i] [deg] and cone_indices[j] [psi], both rising. A cell whose
 grade or CI lies outside the table's range has no value (NaN): the table says nothing there, and
@@ -9,6 +10,7 @@ conservative speed); a CI below the lowest keeps no value (softer soil than any 
 be slower than the softest: taking its speed would be optimistic); grades are never clamped.
 """
 import numpy as np
+from scipy.interpolate import RegularGridInterpolator
 
 
 def bilinear(grades, cone_indices, speed, g, ci, clamp_ci=False):
@@ -23,19 +25,12 @@ def bilinear(grades, cone_indices, speed, g, ci, clamp_ci=False):
     ci = np.asarray(ci, dtype=float)
     if clamp_ci:
         ci = np.minimum(ci, cx[-1])
-    inside = (g >= gx[0]) & (g <= gx[-1]) & (ci >= cx[0]) & (ci <= cx[-1])
-
-    def locate(axis, x):
-        if axis.size == 1:
-            return np.zeros(x.shape, dtype=np.intp), np.zeros(x.shape)
-        k = np.clip(np.searchsorted(axis, x, side='right') - 1, 0, axis.size - 2)
-        t = (x - axis[k]) / (axis[k + 1] - axis[k])
-        return k, t
-
-    gi, tg = locate(gx, np.where(inside, g, gx[0]))
-    cj, tc = locate(cx, np.where(inside, ci, cx[0]))
-    gi1 = np.minimum(gi + 1, gx.size - 1)
-    cj1 = np.minimum(cj + 1, cx.size - 1)
-    v = ((1 - tg) * (1 - tc) * s[gi, cj] + tg * (1 - tc) * s[gi1, cj] +
-         (1 - tg) * tc * s[gi, cj1] + tg * tc * s[gi1, cj1])
-    return np.where(inside, v, np.nan)
+    inside = (g >= gx[0]) & (g <= gx[-1]) & (ci >= cx[0]) & (ci <= cx[-1])   # (False where NaN)
+    # an axis of one value is left out (the table is constant along it): RegularGridInterpolator
+    # gives no value on a 1 x 1 grid
+    axes = [(axis, np.where(inside, x, axis[0])) for axis, x in ((gx, g), (cx, ci)) if axis.size > 1]
+    if not axes:
+        return np.where(inside, s[0, 0], np.nan)
+    table = RegularGridInterpolator(tuple(a for a, _ in axes), s.reshape([a.size for a, _ in axes]),
+                                    method='linear', bounds_error=False, fill_value=np.nan)
+    return np.where(inside, table(np.stack([x for _, x in axes], axis=-1)), np.nan)
