@@ -20,6 +20,8 @@ import sys
 
 import yaml
 
+from .runs import read_result
+
 VERDICTS = {'ok', 'steady', 'command_limited', 'no_go', 'not_steady', 'sunk'}
 
 
@@ -56,13 +58,9 @@ def main(argv=None):
     child.wait()
     status = []
     for f in files:
-        try:
-            with open(f) as fh:
-                r = yaml.safe_load(fh) or {}
-        except (OSError, yaml.YAMLError):
-            r = {}
-        if not r.get('status'):
-            print('dm-launch: the run wrote no result (%s)' % f, file=sys.stderr)
+        r, why = read_result(f)
+        if r is None or not r.get('status'):
+            print('dm-launch: the run wrote no result (%s)' % (why or f + ': no status'), file=sys.stderr)
             return 3
         status.append((r['status'], r.get('error', ''), f))
     for s, err, f in status:

@@ -46,6 +46,10 @@ def dm_run_scene(explicit=None):
                            or os.path.join(build_dir(), 'core', 'src', 'core', 'dm_run_scene'))
 
 
+RUNNER_HELP = ('the core runner (default $DM_RUN_SCENE, else $DM_BUILD/core/src/core/dm_run_scene, '
+               'DM_BUILD defaulting to the checkout\'s build/)')
+
+
 def missing_runner_message(path):
     """What to say when the core runner is not at `path`."""
     return ('no dm_run_scene at %s (build the core: cmake -S . -B build/core -DDM_BUILD_ROS=OFF && '

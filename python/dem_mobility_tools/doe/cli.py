@@ -567,9 +567,8 @@ def parser():
                        'case), OUT/doe_table.csv/.yaml and the plots. --resume keeps the finished cases.')
     design_args(p)
     p.add_argument('--runner', choices=('roslaunch', 'core'), default='roslaunch',
-                   help='roslaunch (default: the launch files, a bag per case) or core (dm_run_scene: $DM_RUN_SCENE, else '
-                   '$DM_BUILD/core/src/core/dm_run_scene, DM_BUILD defaulting to the checkout\'s build/; '
-                   'the same loop in one process, no bag)')
+                   help='roslaunch (default: the launch files, a bag per case) or core (dm_run_scene, the same loop '
+                   'in one process, no bag; ' + paths.RUNNER_HELP + ')')
     p.add_argument('--backend', choices=('local', 'slurm'), default='local',
                    help='local: a process pool here (default); slurm: one job array (sbatch --array), a task per '
                    'case, in --out (a folder every node sees)')

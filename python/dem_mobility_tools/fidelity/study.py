@@ -322,8 +322,7 @@ def main(argv=None):
     ap.add_argument('--port', type=int, default=11511)
     ap.add_argument('--runner', choices=('roslaunch', 'core'), default='roslaunch')
     ap.add_argument('--dm-run-scene', default=None,
-                    help='--runner core: the core runner (default $DM_RUN_SCENE, else '
-                         '$DM_BUILD/core/src/core/dm_run_scene, DM_BUILD defaulting to the checkout\'s build/)')
+                    help='--runner core: ' + paths.RUNNER_HELP)
     ap.add_argument('--resume', action='store_true', help='keep the runs whose result is already good')
     ap.add_argument('--checkpoint-every', type=float, default=600.0,
                     help='--runner core: wall seconds between checkpoints of a run (0: none); a run that was '

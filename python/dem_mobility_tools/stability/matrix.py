@@ -39,7 +39,7 @@ import yaml
 
 from .. import paths
 from ..paths import CONFIG, ROOT
-from ..runs import scene_command
+from ..runs import read_result, scene_command
 
 # the launch file of each scene (runs.LAUNCHES; the matrix runs the core runner only)
 LAUNCH = {'road': 'road_slope.launch', 'wheel': 'single_wheel.launch', 'soil': 'soil_slope.launch'}
@@ -241,8 +241,7 @@ def main(argv=None):
     ap.add_argument('--jobs', type=int, default=1)
     ap.add_argument('--timeout', type=float, default=3600.0, help='longest a cell may take [s]')
     ap.add_argument('--dm-run-scene', default=None,
-                    help='the core runner (default $DM_RUN_SCENE, else $DM_BUILD/core/src/core/dm_run_scene, '
-                         'DM_BUILD defaulting to the checkout\'s build/)')
+                    help=paths.RUNNER_HELP)
     ap.add_argument('--out', default=os.path.join(ROOT, 'results', 'stability'))
     a = ap.parse_args(argv)
     a.dm_run_scene = paths.dm_run_scene(a.dm_run_scene)
@@ -273,10 +272,7 @@ def main(argv=None):
         cmd = scene_command('core', LAUNCH[scene], scene=s['file'], core_args=s['base'] + overrides, result=result_file,
                             core_options=['--quiet'], dm_run_scene=a.dm_run_scene)
         rc, text, wall = run(cmd, base + '.log', a.timeout)
-        result = None
-        if os.path.exists(result_file):
-            with open(result_file) as f:
-                result = yaml.safe_load(f)
+        result, _ = read_result(result_file)  # (None when the run left none: judge says what the run did)
         verdict, detail = judge(rc, text, result, guarded=name in ('dt0.5', 'dt0.9'))
         return dict(scene=scene, cell=name, what=what, overrides=overrides, exit=rc, verdict=verdict, detail=detail,
                     wall_time=round(wall, 1))

@@ -377,8 +377,7 @@ def main(argv=None):
     ap.add_argument('--runner', choices=('roslaunch', 'core'), default='roslaunch',
                     help='roslaunch single_wheel.launch (default), or core: dm_run_scene, a developer check only')
     ap.add_argument('--dm-run-scene', default=None,
-                    help='--runner core: the core runner (default $DM_RUN_SCENE, else '
-                         '$DM_BUILD/core/src/core/dm_run_scene, DM_BUILD defaulting to the checkout\'s build/)')
+                    help='--runner core: ' + paths.RUNNER_HELP)
     ap.add_argument('--progress', choices=('auto', 'tqdm', 'plain'), default='auto')
     ap.add_argument('--out', default='results/single_wheel')
     a = ap.parse_args(argv)
