@@ -2,6 +2,8 @@
 # dm_core), launch files and ROS tests. The core (src/core) never sees any of this.
 find_package(catkin REQUIRED COMPONENTS geometry_msgs message_generation nav_msgs nodelet pluginlib rosbag
   rosgraph_msgs roscpp sensor_msgs std_msgs tf2_msgs topic_tools visualization_msgs)
+# the Python package dem_mobility_tools (setup.py, python/) on the workspace's PYTHONPATH, devel and install
+catkin_python_setup()
 
 add_message_files(DIRECTORY msg FILES
   WheelStates.msg
@@ -26,8 +28,23 @@ catkin_package(
     tf2_msgs topic_tools visualization_msgs
 )
 install(DIRECTORY include/${PROJECT_NAME}/ DESTINATION ${CATKIN_PACKAGE_INCLUDE_DESTINATION})
-catkin_install_python(PROGRAMS scripts/plot_speed.py scripts/plot_compression.py scripts/calibrate_cone_index.py
-  scripts/publish_map.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+# its console scripts (pyproject.toml) as programs of the package: rosrun dem_mobility dm-doe ..., and
+# the nodes of the launch files (mobility_map.launch: dm-publish-map)
+catkin_install_python(PROGRAMS
+  python/bin/dm-doe
+  python/bin/dm-calibrate
+  python/bin/dm-wheel-sweep
+  python/bin/dm-fidelity-study
+  python/bin/dm-plot-fidelity
+  python/bin/dm-stability
+  python/bin/dm-publish-map
+  python/bin/dm-bench-doe-map
+  python/bin/dm-plot-speed
+  python/bin/dm-plot-compression
+  python/bin/dm-driveshaft-curves
+  python/bin/dm-launch
+  python/bin/dm-docs
+  DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)
   find_package(rostest REQUIRED)

@@ -169,5 +169,5 @@ if [ "$want" = all ] || [ "$want" = soil_scene ]; then
 fi
 
 if [ "$want" = all ] || [ "$want" = doe_map ]; then
-  python3 "$DM_ROOT/scripts/tools/bench_doe_map.py" "$tmp/doe_map"
+  PYTHONPATH="$DM_ROOT/python${PYTHONPATH:+:$PYTHONPATH}" python3 -m dem_mobility_tools.maps.bench "$tmp/doe_map"
 fi

@@ -12,7 +12,8 @@ DM_CORE_PACKAGES=(cmake ninja-build make g++ libeigen3-dev libyaml-cpp-dev libgt
 DM_ROS_PACKAGES=(catkin ros-core-dev rosbash libroscpp-dev libnodeletlib-dev librosbag-dev libtf2-ros-dev
   libtf2-eigen-dev libnodeletlib-tools ros-geometry-msgs ros-sensor-msgs ros-visualization-msgs ros-message-generation
   ros-nav-msgs python3-nav-msgs python3-tf2-msgs ros-rosgraph-msgs ros-tf2-msgs libtopic-tools-dev pluginlib-dev
-  python3-rosbag python3-roslaunch python3-rostest python3-catkin-pkg python3-std-msgs python3-geometry-msgs python3-nodelet python3-matplotlib python3-numpy python3-yaml python3-tqdm)
+  python3-rosbag python3-roslaunch python3-rostest python3-catkin-pkg python3-std-msgs python3-geometry-msgs python3-nodelet python3-matplotlib python3-numpy python3-yaml python3-tqdm
+  python3-scipy python3-setuptools python3-venv python3-pip)
 # the maps of the design of experiments (GDAL's tools and python bindings)
 DM_MAP_PACKAGES=(gdal-bin python3-gdal)
 # the Slurm backend of the design of experiments and its single-node test cluster

@@ -57,4 +57,4 @@ if r.get('terrain_model') == 'dem_soil':
         r.get('fidelity'), '%.4g psi' % ci if isinstance(ci, (int, float)) and ci == ci else 'unknown', r.get('cohesion_factor'),
         ' '.join('%.3f' % s for s in r['slip']), ' '.join('%.3f' % s for s in r['sinkage']), r['drawbar_margin']))
 EOF
-echo "plot: python3 scripts/plot_speed.py $bag"
+echo "plot: source $DM_WS/devel/setup.bash && rosrun dem_mobility dm-plot-speed $bag"

@@ -43,8 +43,9 @@ if ! catkin_test_results --verbose "$DM_WS/build/test_results/dem_mobility"; the
   echo "catkin tests failed; full log: $DM_BUILD/run_tests.log"
   exit 1
 fi
-say "test: the sweep package, the sweeps and the wheel references (python unit tests, no ROS; one tiny wheel run through the core)"
-(cd "$DM_ROOT" && DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 -m unittest discover -s test/python -v)
+say "test: the Python package dem_mobility_tools (python unit tests, no ROS; one tiny wheel run through the core; installed by pip, its console scripts)"
+(cd "$DM_ROOT" && PYTHONPATH="$DM_ROOT/python${PYTHONPATH:+:$PYTHONPATH}" DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" \
+  python3 -m unittest discover -s test/python -v)
 say "test: the bag recorder on its own (a latched message delivered twice is recorded once)"
 python3 "$DM_ROOT/test/ros/test_bag_recorder.py"
 say "test: end-to-end road runs through roslaunch"

@@ -1,10 +1,10 @@
-"""scripts/calibrate_cone_index.py without ROS: stand-in `roslaunch` and `rospack` commands on PATH
+"""dm-calibrate (dem_mobility_tools.calibration) without ROS: stand-in `roslaunch` and `rospack` commands on PATH
 write the result files a cone run would; the sweep's lines, files and exit status are those the
 end-to-end test (test/ros/test_cone_sweep.py) checks, --resume keeps the good runs, and with several
 seeds the table holds each f's mean and scatter over the seeds, the particle diameter of the level
 and its provenance.
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import hashlib
 import os
@@ -90,7 +90,7 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
     @classmethod
     def sweep(cls, f, *more, out=None):
         return subprocess.run(
-            [sys.executable, os.path.join(ROOT, 'scripts', 'calibrate_cone_index.py'), '--fidelity', 'tiny',
+            [sys.executable, '-m', 'dem_mobility_tools.calibration.cone_index', '--fidelity', 'tiny',
              '--f', f, '--mu', '0.1', '--jobs', '2', '--cloud-rate', '10', '--port', '11711', '--out', out or cls.out]
             + list(more), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
             env=cls.env, timeout=300)
@@ -211,7 +211,7 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
                             'nowhere/: no such directory')):
             out = os.path.join(self.tmp, 'refused_%d' % len(what))
             r = subprocess.run(
-                [sys.executable, os.path.join(ROOT, 'scripts', 'calibrate_cone_index.py'), '--fidelity', 'tiny',
+                [sys.executable, '-m', 'dem_mobility_tools.calibration.cone_index', '--fidelity', 'tiny',
                  '--mu', '0.1', '--port', '11711', '--out', out] + args, stdout=subprocess.PIPE,
                 stderr=subprocess.STDOUT, universal_newlines=True, env=self.env, timeout=60)
             self.assertNotEqual(r.returncode, 0, r.stdout)
@@ -249,7 +249,7 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         with open(os.path.join(out, 'sweep.yaml'), 'w') as fh:
             fh.write('stale: a summary of an earlier sweep\n')
         p = subprocess.Popen(
-            [sys.executable, os.path.join(ROOT, 'scripts', 'calibrate_cone_index.py'), '--fidelity', 'tiny',
+            [sys.executable, '-m', 'dem_mobility_tools.calibration.cone_index', '--fidelity', 'tiny',
              '--f', '0.5,7', '--mu', '0.1', '--jobs', '2', '--port', '11731', '--out', out],
             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, env=self.env)
         done = os.path.join(out, 'runs', 'mu0.1_f0.5_s1.result.yaml')

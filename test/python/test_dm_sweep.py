@@ -1,7 +1,7 @@
-"""Unit tests of scripts/dm_sweep (no ROS, no C++ build): the runs are a small stand-in python
+"""Unit tests of dem_mobility_tools.sweep (no ROS, no C++ build): the runs are a small stand-in python
 command that writes a result YAML (or fails, hangs, crashes, as its case says).
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import io
 import os
@@ -16,8 +16,7 @@ import unittest
 import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-import dm_sweep  # noqa: E402
+from dem_mobility_tools import sweep as dm_sweep
 
 # the stand-in run: its case's mode says what it does; it appends 'start/end <name> <time> <port>'
 # to the journal and writes its result to DM_SWEEP_RESULT
@@ -65,8 +64,7 @@ if mode == 'exit_after_result':  # a good result, then a failing exit
 
 # a sweep driven from a process of its own (the SIGTERM test)
 DRIVER = r"""import sys
-sys.path.insert(0, %r)
-import dm_sweep
+from dem_mobility_tools import sweep as dm_sweep
 cases = dm_sweep.cases([{'mode': 'ok', 'x': 1}, {'mode': 'hang', 'x': 2}])
 cmd = lambda case, run: [sys.executable, %r, case.params['mode'], '0', %r, str(case.params['x'])]
 s = dm_sweep.Sweep(cases, cmd, %r, jobs=1, poll=0.02, progress='plain', port=%d, timeout=60)
@@ -245,7 +243,7 @@ class Pool(Base):
         import subprocess
         driver = os.path.join(self.tmp, 'driver.py')
         with open(driver, 'w') as fh:
-            fh.write(DRIVER % (os.path.join(ROOT, 'scripts'), self.script, self.journal, self.runs, free_port_base()))
+            fh.write(DRIVER % (self.script, self.journal, self.runs, free_port_base()))
         p = subprocess.Popen([sys.executable, driver], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         pid_file = self.journal + '.modehang_x2.pid'
         t0 = time.time()

@@ -1,9 +1,9 @@
-"""Tests of the `doe` command (scripts/doe): every command's --help, the NRMM table and its map on
+"""Tests of the `dm-doe` command (dem_mobility_tools.doe): every command's --help, the NRMM table and its map on
 the shipped raster (GeoTIFF with the input's CRS, PNG, ROS map, difference map), the plan's cost
 with and without pruning, and the refusals (a raster without CRS, an empty grid, a cone index
 outside the level's calibration range).
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import os
 import re
@@ -17,16 +17,17 @@ import numpy as np
 import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import interp, nrmm, raster  # noqa: E402
-from osgeo import gdal, osr  # noqa: E402
+from osgeo import gdal, osr
 
-DOE = os.path.join(ROOT, 'scripts', 'doe')
+from dem_mobility_tools.doe import interp, raster
+from dem_mobility_tools.terramechanics import nrmm
+
+DOE = [sys.executable, '-m', 'dem_mobility_tools.doe']  # dm-doe
 ST_HELENS = os.path.join(os.path.dirname(ROOT), 'shared', 'data', 'mount_st_helens_30m_utm10n_nad27.tif')
 
 
 def doe(*args, env=None):
-    p = subprocess.run([sys.executable, DOE] + list(args), capture_output=True, text=True, env=env)
+    p = subprocess.run(DOE + list(args), capture_output=True, text=True, env=env)
     return p.returncode, p.stdout, p.stderr
 
 
@@ -43,7 +44,7 @@ class Doe(unittest.TestCase):
         for cmd in ([], ['plan'], ['nrmm'], ['map']):
             rc, out, _ = doe(*(cmd + ['--help']))
             self.assertEqual(rc, 0, cmd)
-            self.assertIn('usage: doe', out)
+            self.assertIn('usage: dm-doe', out)
 
     def test_nrmm_table_and_its_map_beside_itself(self):
         out = os.path.join(self.tmp, 'nrmm')

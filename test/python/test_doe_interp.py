@@ -1,17 +1,15 @@
-"""Unit tests of scripts/dm_doe/interp.py: bilinear interpolation is exact on a plane (and on the
+"""Unit tests of dem_mobility_tools.doe.interp: bilinear interpolation is exact on a plane (and on the
 bilinear a + b g + c CI + d g CI inside each table cell), NaN outside (the map timing is a benchmark).
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import os
-import sys
 import unittest
 
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import interp, plan  # noqa: E402
+from dem_mobility_tools.doe import interp, plan
 
 G, C = np.array(plan.PAPER_GRADES), np.array(plan.PAPER_CONE_INDICES)   # uneven CI spacing
 
@@ -45,6 +43,18 @@ class Bilinear(unittest.TestCase):
         clamped = interp.bilinear(G, C, table, np.array([40.0, 10.0, 10.0]), np.array([100.0, 20.0, 400.0]),
                                   clamp_ci=True)
         np.testing.assert_array_equal(clamped, [np.nan, np.nan, 2.0])
+
+    def test_a_hand_computed_value(self):
+        # grades 0, 10 and CI 100, 200; at grade 2.5 (t 0.25) and CI 175 (u 0.75):
+        # 0.75 * 0.25 * 1 + 0.25 * 0.25 * 5 + 0.75 * 0.75 * 3 + 0.25 * 0.75 * 11 = 4.25 (exact in binary)
+        out = interp.bilinear([0.0, 10.0], [100.0, 200.0], [[1.0, 3.0], [5.0, 11.0]], np.array([2.5]),
+                              np.array([175.0]))
+        self.assertEqual(out[0], 4.25)
+
+    def test_a_one_cell_table_holds_its_value_at_its_point_only(self):
+        out = interp.bilinear([12.0], [30.0], [[2.0]], np.array([12.0, 12.0, 12.5, np.nan]),
+                              np.array([30.0, 31.0, 30.0, 30.0]))
+        np.testing.assert_array_equal(out, [2.0, np.nan, np.nan, np.nan])
 
     def test_a_single_grade_interpolates_along_ci(self):
         out = interp.bilinear([12.0], [30.0, 50.0], [[2.0, 6.0]], np.array([12.0, 12.0]), np.array([40.0, 50.0]))

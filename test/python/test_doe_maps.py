@@ -1,21 +1,20 @@
-"""Unit tests of scripts/dm_doe/maps.py: the ROS map read back by map_server's rules gives the
+"""Unit tests of dem_mobility_tools.doe.maps: the ROS map read back by map_server's rules gives the
 occupancy the speeds mean (no-go 100, top speed 0, no value -1, bottom row first), and the three
 products of a map are written with the raster's CRS and geotransform.
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import os
 import shutil
-import sys
 import tempfile
 import unittest
 
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import maps, raster  # noqa: E402
-from osgeo import gdal, osr  # noqa: E402
+from osgeo import gdal, osr
+
+from dem_mobility_tools.doe import maps, raster
 
 
 class RosMap(unittest.TestCase):

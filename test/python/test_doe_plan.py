@@ -1,16 +1,15 @@
-"""Unit tests of scripts/dm_doe/plan.py: the grid's checks, the run order and the pruning by
+"""Unit tests of dem_mobility_tools.doe.plan: the grid's checks, the run order and the pruning by
 monotone bounds (speed falls with grade, rises with cone index).
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import os
 import random
-import sys
 import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import nrmm, plan  # noqa: E402
+from dem_mobility_tools.doe import plan
+from dem_mobility_tools.terramechanics import nrmm
 
 
 def monotone_table(ng, nc, rng, vmax=25.0):

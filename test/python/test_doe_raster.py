@@ -1,23 +1,22 @@
-"""Unit tests of scripts/dm_doe/raster.py (GDAL): slopes against gdaldem on the shipped raster,
+"""Unit tests of dem_mobility_tools.doe.raster (GDAL): slopes against gdaldem on the shipped raster,
 per-cell maximum slope and minimum cone index on planes (exact), the GeoTIFF keeping its CRS and
 geotransform, the CI generator, and the refusals (no CRS, bad cell size).
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import math
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import unittest
 
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import raster  # noqa: E402
-from osgeo import gdal, osr  # noqa: E402
+from osgeo import gdal, osr
+
+from dem_mobility_tools.doe import raster
 
 DATA = os.path.join(os.path.dirname(ROOT), 'shared', 'data')
 ST_HELENS = os.path.join(DATA, 'mount_st_helens_30m_utm10n_nad27.tif')
@@ -55,6 +54,21 @@ class Raster(unittest.TestCase):
         self.assertGreater(m.sum(), 0.99 * (e.shape[0] - 2) * (e.shape[1] - 2))
         np.testing.assert_allclose(s[m], ref.values[m], rtol=0, atol=1e-4)   # gdaldem writes float32
         self.assertTrue(np.isnan(s[~m]).all())
+
+    def test_horn_slope_of_a_plane_is_its_analytic_slope(self):
+        # z = 0.3 x - 0.7 y on posts 25 m apart east, 40 m north: slope atan(hypot(0.3, 0.7))
+        # everywhere inside; no value on the outer ring (no neighbour on one side) nor around a hole
+        x, y = 25.0 * np.arange(12), 40.0 * np.arange(9)
+        z = 0.3 * x[None, :] - 0.7 * (-y[:, None])
+        z[4, 6] = np.nan
+        s = raster.horn_slope(z, 25.0, 40.0)
+        want = math.degrees(math.atan(math.hypot(0.3, 0.7)))
+        hole = np.zeros(z.shape, dtype=bool)
+        hole[3:6, 5:8] = True
+        inner = np.zeros(z.shape, dtype=bool)
+        inner[1:-1, 1:-1] = True
+        np.testing.assert_allclose(s[inner & ~hole], want, rtol=0, atol=1e-12)
+        self.assertTrue(np.isnan(s[~inner | hole]).all())
 
     def test_per_cell_slope_and_cone_index_are_exact_on_planes(self):
         # elevation: a plane rising 0.3 to the east and 0.4 to the north (slope atan 0.5 everywhere),

@@ -1,10 +1,10 @@
-"""Tests of `doe run`, `doe status` and `doe case` (scripts/dm_doe/runner.py) on the local pool with
+"""Tests of `doe run`, `doe status` and `doe case` (dem_mobility_tools.doe.runner) on the local pool with
 real runs: road cases through the core runner (build/core's dm_run_scene, about 9 s each), where the
 outcomes are known from the power balance (the rigid road at 0-2 deg: the vehicle reaches the
 25 m/s command), so the pruning, resume and retry can be checked against them; and the worker's
 decisions (implied or run, with cases in flight) on made-up states.
 
-    DM_RUN_SCENE=build/core/src/core/dm_run_scene python3 test/python/test_doe_run.py
+    PYTHONPATH=python DM_RUN_SCENE=build/core/src/core/dm_run_scene python3 test/python/test_doe_run.py
 """
 import os
 import shutil
@@ -17,18 +17,18 @@ import unittest
 import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import cli, plan, runner, slurm  # noqa: E402
-from dm_doe.local_cluster import LocalCluster  # noqa: E402
+from dem_mobility_tools import paths
+from dem_mobility_tools.doe import cli, plan, runner, slurm
+from dem_mobility_tools.doe.local_cluster import LocalCluster
 
-DOE = os.path.join(ROOT, 'scripts', 'doe')
-DM_RUN_SCENE = os.environ.get('DM_RUN_SCENE', os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene'))
+DOE = [sys.executable, '-m', 'dem_mobility_tools.doe']  # dm-doe
+DM_RUN_SCENE = paths.dm_run_scene()
 
 
 def doe(*args, env=None):
     e = dict(os.environ, DM_RUN_SCENE=DM_RUN_SCENE)
     e.update(env or {})
-    p = subprocess.run([sys.executable, DOE] + list(args), capture_output=True, text=True, env=e)
+    p = subprocess.run(DOE + list(args), capture_output=True, text=True, env=e)
     return p.returncode, p.stdout, p.stderr
 
 
@@ -157,7 +157,7 @@ class CaseSignals(unittest.TestCase):
             fh.write('#!/bin/sh\nexec %s -c "$STAND_IN_CODE" %g %g "$@"\n' % (sys.executable, before, after))
         os.chmod(self.exe, 0o755)
         env = dict(os.environ, DM_RUN_SCENE=self.exe, STAND_IN_CODE=STAND_IN)
-        p = subprocess.Popen([sys.executable, DOE, 'case', '--out', self.out, '--index', '0'], env=env,
+        p = subprocess.Popen(DOE + ['case', '--out', self.out, '--index', '0'], env=env,
                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         case = self.doc['cases'][0]
         written = runner.result_path(self.out, case) + '.written'
@@ -333,7 +333,7 @@ class RoadDoe(unittest.TestCase):
         grid = ['--grades', '0,1,2', '--cone-indices', '300', '--runner', 'core', '--progress', 'plain', '--no-prune',
                 '--duration', '8']
         env = dict(os.environ, DM_RUN_SCENE=DM_RUN_SCENE)
-        p = subprocess.Popen([sys.executable, DOE, 'run', '--out', out] + grid, stdout=subprocess.DEVNULL,
+        p = subprocess.Popen(DOE + ['run', '--out', out] + grid, stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL, env=env, start_new_session=True)
         first, marker = os.path.join(out, 'runs', 'g0_ci300.result.yaml'), os.path.join(out, 'runs', 'g2_ci300.running')
         t0 = time.time()
@@ -403,7 +403,7 @@ def have_slurm():
 @unittest.skipUnless(have_slurm(), 'no Slurm (scripts/lib.sh DM_SLURM_PACKAGES)')
 class SlurmDoe(unittest.TestCase):
     """A 3 x 3 DOE at the tiny level (grades 0, 12, 24 deg x CI 50, 100 psi on the soil and 300, the
-    road) on the local pool and as a job array on a real single-node cluster (dm_doe.local_cluster:
+    road) on the local pool and as a job array on a real single-node cluster (dem_mobility_tools.doe.local_cluster:
     its own munge key, slurm.conf and ports in a temporary directory): the two tables are the same,
     bit for bit. The soil cases take a scene file of the test's own (--soil-scene: soil only in
     0.6 m strips under the tracks, a 6 m box, 0.2 s of settling) and every case 0.3 s of driving

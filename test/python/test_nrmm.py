@@ -1,18 +1,16 @@
-"""Unit tests of scripts/dm_doe/nrmm.py against the figures worked out independently in
+"""Unit tests of dem_mobility_tools.terramechanics.nrmm against the figures worked out independently in
 ../shared/reference/nrmm-baseline.md (the M998 worked example of section 3, the VTI sanity table of
 section 4.3 and the illustrative speed table of section 5), and its refusals of bad input.
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import math
 import os
-import sys
 import tempfile
 import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import nrmm  # noqa: E402
+from dem_mobility_tools.terramechanics import nrmm
 
 HP = 745.699872
 # the M998 of nrmm-baseline.md: 7,700 lb, 37 x 12.5 in tires, 16 in clearance, 150 hp, automatic;

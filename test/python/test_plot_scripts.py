@@ -9,7 +9,7 @@ import tempfile
 import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SCRIPT = os.path.join(ROOT, 'scripts', 'plot_compression.py')
+TOOL = [sys.executable, '-m', 'dem_mobility_tools.plots.compression']  # dm-plot-compression
 
 
 class PlotCompression(unittest.TestCase):
@@ -23,7 +23,7 @@ class PlotCompression(unittest.TestCase):
         path = os.path.join(self.tmp, 'result.yaml')
         with open(path, 'w') as fh:
             fh.write(text)
-        return path, subprocess.run([sys.executable, SCRIPT, path] + list(args), capture_output=True, text=True)
+        return path, subprocess.run(TOOL + [path] + list(args), capture_output=True, text=True)
 
     def test_a_result_without_the_compression_keys_is_refused_naming_the_key(self):
         path, p = self.run_script('scene: road_slope\nloading: [[1000, 1200]]\nunloading: []\n')

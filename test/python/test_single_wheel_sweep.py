@@ -1,12 +1,11 @@
-"""scripts/single_wheel_sweep.py: its cases and commands (the arguments single_wheel.launch takes),
+"""dm-wheel-sweep (dem_mobility_tools.wheel.sweep): its cases and commands (the arguments single_wheel.launch takes),
 and, without ROS, whole sweeps through stand-in `roslaunch` and `rospack` commands on PATH that
 write the result files a single-wheel run would (sunk wheels, failures, towed runs): the lines,
 summary.yaml (figures, references at the same slips, sim - VTI), the plots, the exit status and
 --resume. With the core built (build/core or $DM_RUN_SCENE), one real tiny run through --runner core.
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
-import importlib.util
 import json
 import math
 import os
@@ -21,14 +20,12 @@ import unittest
 import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SCRIPT = os.path.join(ROOT, 'scripts', 'single_wheel_sweep.py')
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-import dm_sweep  # noqa: E402
-from dm_sweep import wheel_numerics as wn  # noqa: E402
+TOOL = [sys.executable, '-m', 'dem_mobility_tools.wheel.sweep']  # dm-wheel-sweep
 
-spec = importlib.util.spec_from_file_location('single_wheel_sweep', SCRIPT)
-sws = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(sws)
+from dem_mobility_tools import paths
+from dem_mobility_tools import sweep as dm_sweep
+from dem_mobility_tools.terramechanics import wheel_numerics as wn
+from dem_mobility_tools.wheel import sweep as sws
 
 try:
     import matplotlib  # noqa: F401
@@ -132,10 +129,10 @@ class Cases(unittest.TestCase):
         a = args(mu=0.05, fidelity='tiny')
         case = sws.make_cases('ci', [100], [0.3])[0]
         self.assertEqual(sws.core_command(a, case, 'runs/x.result.yaml'), [
-            '/x/dm_run_scene', a.scene, 'fidelity=tiny', 'threads=1', 'cone_index=100', 'wheel.drive=slip',
-            'wheel.slip=0.3', 'friction=0.05', '--out', os.path.abspath('runs/x.result.yaml')])
+            '/x/dm_run_scene', a.scene, 'fidelity=tiny', 'cone_index=100', 'wheel.slip=0.3', 'wheel.drive=slip',
+            'threads=1', 'friction=0.05', '--out', os.path.abspath('runs/x.result.yaml')])
         towed = sws.make_cases('f', [2], [], towed=True)[0]
-        self.assertEqual(sws.core_command(args(), towed, '/r.yaml')[4:6], ['cohesion_factor=2', 'wheel.drive=towed'])
+        self.assertEqual(sws.core_command(args(), towed, '/r.yaml')[3:5], ['cohesion_factor=2', 'wheel.drive=towed'])
 
     def test_resume_accepts_the_same_run_only(self):
         accept = sws.same_run(args(fidelity='tiny', load=1230))
@@ -260,7 +257,7 @@ class SweepWithoutRos(unittest.TestCase):
     @classmethod
     def sweep(cls, slips, *more):
         return subprocess.run(
-            [sys.executable, SCRIPT, '--fidelity', 'tiny', '--ci', '20,100', '--slip', slips, '--towed',
+            TOOL + ['--fidelity', 'tiny', '--ci', '20,100', '--slip', slips, '--towed',
              '--jobs', '2', '--port', '11811', '--progress', 'plain', '--out', cls.out] + list(more),
             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, env=cls.env, timeout=300)
 
@@ -384,7 +381,7 @@ def bag_of(call):
 
 
 def dm_run_scene():
-    p = os.environ.get('DM_RUN_SCENE') or os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene')
+    p = paths.dm_run_scene()
     return p if os.access(p, os.X_OK) else None
 
 
@@ -398,7 +395,7 @@ class RealTinyRun(unittest.TestCase):
         tmp = tempfile.mkdtemp(prefix='dm_wheel_sweep_real_')
         self.addCleanup(shutil.rmtree, tmp, True)
         # CI 100 through the table made at tiny's 0.1 m particles (config/calibration/cone_index_mu0.1_d0.1.yaml)
-        p = subprocess.run([sys.executable, SCRIPT, '--runner', 'core', '--dm-run-scene', dm_run_scene(),
+        p = subprocess.run(TOOL + ['--runner', 'core', '--dm-run-scene', dm_run_scene(),
                             '--fidelity', 'tiny', '--ci', '100', '--slip', '0.3', '--jobs', '1', '--progress', 'plain',
                             '--out', tmp], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
                            env=dict(os.environ, MPLBACKEND='Agg'), timeout=900)

@@ -1,7 +1,7 @@
-"""Unit tests of scripts/soil_fidelity_study.py's summary (no runs): the levels' error estimates
+"""Unit tests of dem_mobility_tools.fidelity.study's summary (no runs): the levels' error estimates
 and the default level by the issue's rule (the cheapest within 1 m/s of the finest in every case).
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import argparse
 import os
@@ -11,8 +11,7 @@ import tempfile
 import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-import soil_fidelity_study as study  # noqa: E402
+from dem_mobility_tools.fidelity import study
 
 
 def rows_of(runs):
@@ -140,7 +139,7 @@ class Resume(unittest.TestCase):
             fh.write('#!/bin/sh\nexec sleep 60\n')
         os.chmod(runner, 0o755)
         out = os.path.join(self.tmp, 'out')
-        p = subprocess.Popen([sys.executable, os.path.join(ROOT, 'scripts', 'soil_fidelity_study.py'), '--runner',
+        p = subprocess.Popen([sys.executable, '-m', 'dem_mobility_tools.fidelity.study', '--runner',
                               'core', '--dm-run-scene', runner, '--levels', 'tiny', '--cases', '0:50', '--out', out],
                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
         t0 = time.time()

@@ -1,10 +1,10 @@
-"""The stability matrix (scripts/stability_matrix.py, docs/stability.md): its judge on made-up
+"""The stability matrix (dm-stability, docs/stability.md): its judge on made-up
 results (a ledger below zero or a NaN is a silent blow-up, an error naming no limit a failure),
 and its cheap cells run through the core runner (DM_RUN_SCENE, or build/core's dm_run_scene): the
 road scene, the single-wheel rig's runs and refusals and the soil scene's refusals, each stable or
 refused naming its limit.
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import os
 import subprocess
@@ -15,10 +15,10 @@ import unittest
 import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-import stability_matrix as matrix  # noqa: E402
+from dem_mobility_tools import paths
+from dem_mobility_tools.stability import matrix
 
-RUNNER = os.environ.get('DM_RUN_SCENE', os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene'))
+RUNNER = paths.dm_run_scene()
 
 
 class Judge(unittest.TestCase):
@@ -60,7 +60,7 @@ class Judge(unittest.TestCase):
 class CheapCells(unittest.TestCase):
     def test_the_cheap_cells_are_stable_or_refused_naming_the_limit(self):
         with tempfile.TemporaryDirectory() as out:
-            p = subprocess.run([sys.executable, os.path.join(ROOT, 'scripts', 'stability_matrix.py'), '--cheap',
+            p = subprocess.run([sys.executable, '-m', 'dem_mobility_tools.stability.matrix', '--cheap',
                                 '--dm-run-scene', RUNNER, '--out', out], capture_output=True, text=True, timeout=1800)
             self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
             with open(os.path.join(out, 'matrix.yaml')) as f:

@@ -1,18 +1,16 @@
-"""scripts/dm_sweep/wheel_numerics.py against nrmm-baseline.md section 4: the VTI and WES numbers of
+"""dem_mobility_tools.terramechanics.wheel_numerics against nrmm-baseline.md section 4: the VTI and WES numbers of
 the baseline's sanity table (section 4.3, a HMMWV wheel: W 8.56 kN, b 0.3175 m, d 0.94 m, delta/h
 0.15; derived in the document, independently of this code), the rigid tire, the units, Brixius and
 Wismer-Luth by hand, and the band.
 
-    python3 -m unittest discover -s test/python -v      (from the repository root)
+    PYTHONPATH=python python3 -m unittest discover -s test/python -v      (from the repository root)
 """
 import math
 import os
-import sys
 import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_sweep import wheel_numerics as wn  # noqa: E402
+from dem_mobility_tools.terramechanics import wheel_numerics as wn
 
 W, B, D, DH = 8560.0, 0.3175, 0.94, 0.15
 # RCI [psi]: N_c VTI, N_c WES, S_sp, DP/W at 20 % slip, MR/W powered, MR/W calibrated (towed)

@@ -3,18 +3,13 @@ port and its own folder (ROS_HOME, the log, the bag and the result YAML beside i
 end-to-end tests under test/ros share."""
 import os
 import signal
-import socket
 import subprocess
 import time
 
 import rosbag
 import yaml
 
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(('localhost', 0))
-        return s.getsockname()[1]
+from dem_mobility_tools.runs import free_port  # noqa: F401 (the tests beside this file take it from here)
 
 
 def stop_group(proc, timeout=20):
@@ -33,8 +28,8 @@ def stop_group(proc, timeout=20):
 class LaunchRun:
     """`roslaunch dem_mobility LAUNCH bag:=DIR/run.bag ARGS...` in DIR = tmp/name; the run's result
     YAML is the bag's name with .result.yaml. `env` adds to the environment; `prefix` goes before
-    roslaunch on its command line (e.g. prlimit and its limits); `program`: roslaunch, or
-    scripts/dm_launch (roslaunch with the run's exit status)."""
+    roslaunch on its command line (e.g. prlimit and its limits); `program`: roslaunch, or the argv
+    of dm-launch (roslaunch with the run's exit status)."""
 
     def __init__(self, tmp, name, launch, *args, env=None, prefix=(), program='roslaunch'):
         self.dir = os.path.join(tmp, name)
@@ -45,7 +40,8 @@ class LaunchRun:
         env = dict(os.environ, ROS_HOME=self.dir, ROS_MASTER_URI='http://localhost:%d' % self.port, **(env or {}))
         self.env = {k: v for k, v in env.items() if v is not None}  # (None: the variable unset)
         self.log = open(os.path.join(self.dir, 'roslaunch.log'), 'w')
-        self.proc = subprocess.Popen(list(prefix) + [program, '-p', str(self.port), 'dem_mobility', launch,
+        program = [program] if isinstance(program, str) else list(program)
+        self.proc = subprocess.Popen(list(prefix) + program + ['-p', str(self.port), 'dem_mobility', launch,
                                       'bag:=' + self.bag] + list(args),
                                      stdout=self.log, stderr=subprocess.STDOUT, env=self.env,
                                      start_new_session=True)

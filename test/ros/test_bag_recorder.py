@@ -17,7 +17,8 @@ import unittest
 
 import rosbag
 
-from launch_run import free_port, stop_group  # beside this file
+from dem_mobility_tools.runs import free_port
+from launch_run import stop_group  # beside this file
 
 PUBLISHER = r'''
 import time

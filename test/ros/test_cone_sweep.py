@@ -22,7 +22,7 @@ class ConeSweep(unittest.TestCase):
     def setUpClass(cls):
         cls.out = tempfile.mkdtemp(prefix='dm_cone_sweep_')
         cls.proc = subprocess.run(
-            [sys.executable, os.path.join(ROOT, 'scripts', 'calibrate_cone_index.py'), '--fidelity', 'tiny',
+            [sys.executable, '-m', 'dem_mobility_tools.calibration.cone_index', '--fidelity', 'tiny',  # dm-calibrate
              '--f', '0.5,8,20', '--mu', '0.1', '--jobs', '2', '--cloud-rate', '10', '--port', '11711',
              '--out', cls.out], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
             timeout=900)

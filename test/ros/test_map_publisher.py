@@ -17,12 +17,9 @@ import unittest
 
 import numpy as np
 
-from launch_run import free_port, stop_group  # beside this file
-
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from dm_doe import maps  # noqa: E402
+from dem_mobility_tools.doe import maps
+from dem_mobility_tools.runs import free_port
+from launch_run import stop_group  # beside this file
 
 
 class MapPublisher(unittest.TestCase):

@@ -15,6 +15,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 import tempfile
 import time
 import unittest
@@ -22,13 +23,14 @@ import unittest
 import rosbag
 import yaml
 
+from dem_mobility_tools import paths
 from launch_run import LaunchRun  # beside this file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-DM_LAUNCH = os.path.join(ROOT, 'scripts', 'dm_launch')  # roslaunch with the run's exit status
+DM_LAUNCH = [sys.executable, '-m', 'dem_mobility_tools.launch']  # dm-launch: roslaunch with the run's exit status
 SCENE = os.path.join(ROOT, 'config', 'scenes', 'road_slope.yaml')
-RUNNER = os.environ.get('DM_RUN_SCENE', os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene'))
+RUNNER = paths.dm_run_scene()
 NS = '/mobility/'
 
 
@@ -144,7 +146,7 @@ class Failures(unittest.TestCase):
         self.assertGreater(len(run.messages([NS + 'odom'])), 10)
 
     def test_killed_terrain_process_stops_the_run_after_the_peer_timeout(self):
-        # through dm_launch: roslaunch itself exits 0 after such an error, dm_launch with 1
+        # through dm-launch: roslaunch itself exits 0 after such an error, dm-launch with 1
         run = Run(self.tmp, 'kill', 'duration:=300', 'standalone:=true', 'peer_timeout:=3', program=DM_LAUNCH)
         self.wait_for_progress(run, 90)
         pids = subprocess.run(['pgrep', '-f', 'standalone dem_mobility/TerrainNodelet.*' + run.dir],
@@ -162,17 +164,17 @@ class Failures(unittest.TestCase):
         self.assertIn('did not answer step', r['error'])
         self.assertLess(time.time() - t0, 30)
         self.assertEqual(run.returncode, 1, run.output()[-2000:])
-        self.assertIn('dm_launch: the run failed: the terrain did not answer step', run.output())
+        self.assertIn('dm-launch: the run failed: the terrain did not answer step', run.output())
 
     def test_sigterm_mid_run_closes_the_bag_and_the_result_says_interrupted(self):
-        # SIGTERM to dm_launch alone (a scheduler's stop, `kill`): it passes it on to roslaunch,
+        # SIGTERM to dm-launch alone (a scheduler's stop, `kill`): it passes it on to roslaunch,
         # which stops its nodes with SIGINT, as Ctrl-C does (test_soil_slope.py sends that one)
         run = Run(self.tmp, 'sigterm', 'duration:=300', program=DM_LAUNCH)
         self.wait_for_progress(run)
         # the run stopped at once: its result was written within seconds of the signal (roslaunch
         # then takes the master down), and says how far it came
         self.assertLess(run.stop(signal.SIGTERM, group=False), 3.0)
-        self.assertEqual(run.returncode, 4, run.output()[-2000:])  # dm_launch passed it on: interrupted
+        self.assertEqual(run.returncode, 4, run.output()[-2000:])  # dm-launch passed it on: interrupted
         r = run.result()
         self.assertEqual(r['status'], 'interrupted', run.output()[-3000:])
         self.assertTrue(r['interrupted'])

@@ -39,11 +39,12 @@ import yaml
 
 import rosbag
 
+from dem_mobility_tools import paths
 from launch_run import LaunchRun, free_port, stop_group  # beside this file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-RUNNER = os.environ.get('DM_RUN_SCENE', os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene'))
+RUNNER = paths.dm_run_scene()
 NS = '/mobility/'
 SHORT = ['settle_time:=0.2', 'duration:=0.2', 'cloud_rate:=10']
 # the keys that hold wall-clock times (they differ from run to run)
@@ -245,7 +246,8 @@ class SoilSlopeRuns(unittest.TestCase):
 
     def test_plot_speed_draws_the_soil_bag(self):
         out = os.path.join(self.tmp, 'speed.png')
-        p = subprocess.run([os.path.join(ROOT, 'scripts', 'plot_speed.py'), self.t1.bag, '-o', out],
+        # as a user runs it: the program catkin installs (python/bin, the package's console script)
+        p = subprocess.run(['rosrun', 'dem_mobility', 'dm-plot-speed', self.t1.bag, '-o', out],
                            capture_output=True, text=True)
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertGreater(os.path.getsize(out), 10000)

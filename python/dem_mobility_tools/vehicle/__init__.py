@@ -1,0 +1,2 @@
+"""Vehicle data derived from the reference: the drive-shaft curves (driveshaft_curves,
+dm-driveshaft-curves)."""
