@@ -44,18 +44,18 @@ if ! catkin_test_results --verbose "$DM_WS/build/test_results/dem_mobility"; the
   exit 1
 fi
 say "test: the Python package dem_mobility_tools (python unit tests, no ROS; one tiny wheel run through the core; installed by pip, its console scripts)"
-(cd "$DM_ROOT" && PYTHONPATH="$DM_ROOT/python${PYTHONPATH:+:$PYTHONPATH}" DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" \
+(cd "$DM_ROOT" && PYTHONPATH="$DM_ROOT/python${PYTHONPATH:+:$PYTHONPATH}" DM_RUN_SCENE="$DM_BUILD/core/src/tools/dm_run_scene" \
   python3 -m unittest discover -s test/python -v)
 say "test: the bag recorder on its own (a latched message delivered twice is recorded once)"
 python3 "$DM_ROOT/test/ros/test_bag_recorder.py"
 say "test: end-to-end road runs through roslaunch"
-DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 "$DM_ROOT/test/ros/test_road_runs.py"
+DM_RUN_SCENE="$DM_BUILD/core/src/tools/dm_run_scene" python3 "$DM_ROOT/test/ros/test_road_runs.py"
 say "test: the cone index calibration sweep on tiny cases (roslaunch, bags, table, plots)"
 python3 "$DM_ROOT/test/ros/test_cone_sweep.py"
 say "test: the single-wheel rig through roslaunch (tiny run: bag, result message and YAML; a bad slip)"
 python3 "$DM_ROOT/test/ros/test_single_wheel.py"
 say "test: the vehicle on the DEM soil patch through roslaunch (tiny: result and soil figures as the core runner's, bag, 1 vs 2 soil threads; a bad cone index; Ctrl-C in the preparation and while driving)"
-DM_RUN_SCENE="$DM_BUILD/core/src/core/dm_run_scene" python3 "$DM_ROOT/test/ros/test_soil_slope.py"
+DM_RUN_SCENE="$DM_BUILD/core/src/tools/dm_run_scene" python3 "$DM_ROOT/test/ros/test_soil_slope.py"
 say "test: the speed-made-good map on ROS (mobility_map.launch: nav_msgs/OccupancyGrid as map_server reads the file)"
 python3 "$DM_ROOT/test/ros/test_map_publisher.py"
 say "test: catkin_lint"

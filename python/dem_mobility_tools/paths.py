@@ -3,7 +3,7 @@
 The checkout is $DM_ROOT if set, else the one this package lives in (python/dem_mobility_tools/,
 also through catkin's devel space, which relays to the source), else the ROS package dem_mobility
 (rospkg), else the current folder. The build folder is $DM_BUILD, else <checkout>/build (as
-scripts/lib.sh). The core runner is $DM_RUN_SCENE, else <build>/core/src/core/dm_run_scene.
+scripts/lib.sh). The core runner is $DM_RUN_SCENE, else <build>/core/src/tools/dm_run_scene.
 """
 import os
 
@@ -41,12 +41,12 @@ def build_dir():
 
 def dm_run_scene(explicit=None):
     """The core runner: `explicit` (an option's value) if given, else $DM_RUN_SCENE, else
-    <build>/core/src/core/dm_run_scene. An absolute path."""
+    <build>/core/src/tools/dm_run_scene. An absolute path."""
     return os.path.abspath(explicit or os.environ.get('DM_RUN_SCENE')
                            or os.path.join(build_dir(), 'core', 'src', 'core', 'dm_run_scene'))
 
 
-RUNNER_HELP = ('the core runner (default $DM_RUN_SCENE, else $DM_BUILD/core/src/core/dm_run_scene, '
+RUNNER_HELP = ('the core runner (default $DM_RUN_SCENE, else $DM_BUILD/core/src/tools/dm_run_scene, '
                'DM_BUILD defaulting to the checkout\'s build/)')
 
 

@@ -45,7 +45,7 @@ open(bag, 'w').write('bag')
 with open(res, 'w') as fh:
     yaml.safe_dump({'fidelity': args['fidelity'], 'cohesion_factor': f, 'friction': mu, 'seed': seed, 'cone_index_psi': ci,
                     'window_samples': 4, 'wall_time': 1.5, 'error': '',
-                    'history': {'t': [0.0, 0.5, 1.0], 'ci_psi': [0.0, ci / 2, ci]}}, fh)
+                    'history': {'t': [0.0, 0.5, 1.0], 'cone_index_psi': [0.0, ci / 2, ci]}}, fh)
 ''' % sys.executable
 
 

@@ -4,7 +4,7 @@ outcomes are known from the power balance (the rigid road at 0-2 deg: the vehicl
 25 m/s command), so the pruning, resume and retry can be checked against them; and the worker's
 decisions (implied or run, with cases in flight) on made-up states.
 
-    PYTHONPATH=python DM_RUN_SCENE=build/core/src/core/dm_run_scene python3 test/python/test_doe_run.py
+    PYTHONPATH=python DM_RUN_SCENE=build/core/src/tools/dm_run_scene python3 test/python/test_doe_run.py
 """
 import os
 import shutil

@@ -37,7 +37,7 @@ class Paths(unittest.TestCase):
         with mock.patch.dict(os.environ, env, clear=True):
             self.assertEqual(paths.dm_run_scene(), os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene'))
             os.environ['DM_BUILD'] = '/b'
-            self.assertEqual(paths.dm_run_scene(), '/b/core/src/core/dm_run_scene')
+            self.assertEqual(paths.dm_run_scene(), '/b/core/src/tools/dm_run_scene')
             os.environ['DM_RUN_SCENE'] = '/x/dm_run_scene'
             self.assertEqual(paths.dm_run_scene(), '/x/dm_run_scene')
             self.assertEqual(paths.dm_run_scene('/y/runner'), '/y/runner')

@@ -234,7 +234,7 @@ def plots(runs, out, mus, fits):
         fig, ax = plt.subplots(figsize=(8, 5))
         for r in sorted(done, key=lambda r: r.f):
             h = r.result['history']
-            ax.plot(h['t'], h['ci_psi'], lw=1.2, label='f = %g, seed %d%s' % (r.f, r.seed, '' if r.ok() else ' (failed)'))
+            ax.plot(h['t'], h['cone_index_psi'], lw=1.2, label='f = %g, seed %d%s' % (r.f, r.seed, '' if r.ok() else ' (failed)'))
         ax.set_xlabel('time since the cone started [s]')
         ax.set_ylabel('cone index [psi]')
         ax.set_title('CI versus time, mu = %g (paper fig. 13)' % mu)
