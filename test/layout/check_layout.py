@@ -5,13 +5,14 @@
    docs/layout.md's room table; a room includes only itself and the rooms above it. The core
    includes nothing of the ROS layer (dem_mobility/ros, ros/, any message header).
 2. No file of the core includes itself back through others (no cycle of includes).
-3. No source file (the library, the nodelets, the tools, the benchmarks) is longer than
-   MAX_FILE_LINES lines, and no function longer than MAX_FUNCTION_LINES, except the ones named in
-   EXCEPTIONS with their reason.
+3. No source file (the library, the nodelets, the tools, the benchmarks, the Python package, the
+   tests) is longer than MAX_FILE_LINES lines, and no function longer than MAX_FUNCTION_LINES,
+   except the ones named in EXCEPTIONS with their reason.
 
 Usage: check_layout.py REPO     (exit 1 naming every breach)
        check_layout.py --self-test  (breaches planted in a copy must be found)
 """
+import ast
 import os
 import re
 import shutil
@@ -129,29 +130,46 @@ def cycles(graph):
     return out
 
 
-def sources(repo):
-    for base in ('include', 'src', 'bench'):
+SOURCE_FOLDERS = ('include', 'src', 'bench', 'python', 'test', 'scripts')
+
+
+def sources(repo, suffixes):
+    for base in SOURCE_FOLDERS:
         for dirpath, _, files in os.walk(os.path.join(repo, base)):
             for f in sorted(files):
-                if f.endswith(('.h', '.cpp')):
+                if f.endswith(suffixes):
                     yield os.path.relpath(os.path.join(dirpath, f), repo)
 
 
-def check_sizes(repo):
-    breaches = []
-    paths = list(sources(repo))
-    for path in paths:
-        n = sum(1 for _ in open(os.path.join(repo, path), encoding='utf-8'))
-        if n > MAX_FILE_LINES:
-            breaches.append(f'{path}: {n} lines (at most {MAX_FILE_LINES})')
-    # functions: universal-ctags gives each definition's first and last line
+def cpp_functions(repo, paths):
+    """(path, name, first line, length) of every C++ function (universal-ctags)."""
     out = subprocess.run(['ctags-universal', '-x', '--_xformat=%N\t%F\t%n\t%{end}', '--kinds-C++=f', '--fields=+ne',
                           '--language-force=C++', *paths], cwd=repo, capture_output=True, text=True, check=True).stdout
     for line in out.splitlines():
         name, path, start, end = line.split('\t')
-        if not end.isdigit():
-            continue
-        length = int(end) - int(start) + 1
+        if end.isdigit():
+            yield path, name, int(start), int(end) - int(start) + 1
+
+
+def python_functions(repo, paths):
+    """(path, name, first line, length) of every Python function (ast)."""
+    for path in paths:
+        with open(os.path.join(repo, path), encoding='utf-8') as f:
+            tree = ast.parse(f.read(), path)
+        for n in ast.walk(tree):
+            if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                yield path, n.name, n.lineno, n.end_lineno - n.lineno + 1
+
+
+def check_sizes(repo):
+    breaches = []
+    cpp = list(sources(repo, ('.h', '.cpp')))
+    py = list(sources(repo, ('.py',)))
+    for path in cpp + py:
+        n = sum(1 for _ in open(os.path.join(repo, path), encoding='utf-8'))
+        if n > MAX_FILE_LINES:
+            breaches.append(f'{path}: {n} lines (at most {MAX_FILE_LINES})')
+    for path, name, start, length in list(cpp_functions(repo, cpp)) + list(python_functions(repo, py)):
         if length > MAX_FUNCTION_LINES and f'{path}:{name}' not in EXCEPTIONS:
             breaches.append(f'{path}:{start}: {name} is {length} lines (at most {MAX_FUNCTION_LINES})')
     return breaches
@@ -167,8 +185,10 @@ def self_test():
     failures = []
     with tempfile.TemporaryDirectory() as tmp:
         copy = os.path.join(tmp, 'repo')
-        for d in ('include', 'src', 'bench', 'docs'):
-            shutil.copytree(os.path.join(repo, d), os.path.join(copy, d))
+        for d in SOURCE_FOLDERS + ('docs',):
+            if os.path.isdir(os.path.join(repo, d)):
+                shutil.copytree(os.path.join(repo, d), os.path.join(copy, d),
+                                ignore=shutil.ignore_patterns('__pycache__'))
         clean = '\n'.join(check(copy))
         order = room_order(copy)
         top, bottom = order[0], order[-1]
@@ -181,6 +201,8 @@ def self_test():
         long_fn = os.path.join(copy, 'src', 'core', top, 'planted_long.cpp')
         with open(long_fn, 'w') as f:
             f.write('int Planted() {\n' + '  int a = 0;\n' * MAX_FUNCTION_LINES + '  return a;\n}\n')
+        with open(os.path.join(copy, 'python', 'planted_long.py'), 'w') as f:
+            f.write('def planted_py():\n' + '    a = 0\n' * MAX_FUNCTION_LINES + '    return a\n')
         long_file = os.path.join(copy, 'src', 'core', top, 'planted_file.cpp')
         with open(long_file, 'w') as f:
             f.write('// line\n' * (MAX_FILE_LINES + 1))
@@ -188,6 +210,7 @@ def self_test():
         for what, needle in (('an include against the order', f'room {bottom}/ stands below {top}/'),
                              ('a cycle', 'include cycle:'),
                              ('a long function', 'Planted is'),
+                             ('a long Python function', 'planted_py is'),
                              ('a long file', 'planted_file.cpp: ')):
             if needle in clean:
                 failures.append(f'{what}: "{needle}" is reported before anything is planted')
