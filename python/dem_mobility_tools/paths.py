@@ -43,7 +43,7 @@ def dm_run_scene(explicit=None):
     """The core runner: `explicit` (an option's value) if given, else $DM_RUN_SCENE, else
     <build>/core/src/tools/dm_run_scene. An absolute path."""
     return os.path.abspath(explicit or os.environ.get('DM_RUN_SCENE')
-                           or os.path.join(build_dir(), 'core', 'src', 'core', 'dm_run_scene'))
+                           or os.path.join(build_dir(), 'core', 'src', 'tools', 'dm_run_scene'))
 
 
 RUNNER_HELP = ('the core runner (default $DM_RUN_SCENE, else $DM_BUILD/core/src/tools/dm_run_scene, '

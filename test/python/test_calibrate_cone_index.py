@@ -29,7 +29,7 @@ except ImportError:
 ROSLAUNCH = r'''#!%s
 import os, sys, time, yaml
 args = dict(a.split(':=', 1) for a in sys.argv[1:] if ':=' in a)
-f, mu, seed, bag = float(args['f']), float(args['mu']), int(args['seed']), args['bag']
+f, mu, seed, bag = float(args['cohesion_factor']), float(args['friction']), int(args['seed']), args['bag']
 assert sys.argv[1] == '-p' and os.environ['ROS_MASTER_URI'].endswith(':' + sys.argv[2])
 with open(os.path.join(os.path.dirname(bag), 'calls'), 'a') as fh:
     fh.write('%%g %%g %%s %%d\n' %% (f, mu, sys.argv[2], seed))

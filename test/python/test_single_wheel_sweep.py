@@ -35,7 +35,7 @@ except ImportError:
     HAVE_PLOTS = False
 
 # the arguments of launch/single_wheel.launch
-LAUNCH_ARGS = {'scene', 'fidelity', 'f', 'mu', 'cone_index', 'slip', 'drive', 'torque', 'load', 'speed',
+LAUNCH_ARGS = {'scene', 'fidelity', 'cohesion_factor', 'friction', 'cone_index', 'slip', 'drive', 'torque', 'load', 'speed',
                'dem_threads', 'seed', 'bag', 'cloud_rate', 'rviz', 'end_run', 'ns'}
 
 # a stand-in single-wheel run: slip >= 0.7 fails (status error, exit 1); CI < 25 sinks before the
@@ -109,14 +109,14 @@ class Cases(unittest.TestCase):
             'roslaunch', '-p', '11413', 'dem_mobility', 'single_wheel.launch', 'scene:=' + a.scene,
             'fidelity:=coarse', 'cone_index:=100', 'slip:=0.2', 'drive:=slip', 'dem_threads:=1',
             'bag:=/data/sweep/runs/ci100_slip0.2.bag', 'cloud_rate:=5', 'rviz:=false', 'end_run:=true'])
-        # every option given, f for the soil, towed: only the launch file's arguments
+        # every option given, f for the soil (cohesion_factor:=), towed: only the launch file's arguments
         a = args(mu=0.05, load=800, speed=0.5, seed=3, dem_threads=2)
         towed = sws.make_cases('f', [1.5], [], towed=True)[0]
         argv = sws.roslaunch_command(a, towed, 11411)
         given = dict(x.split(':=', 1) for x in argv[5:])
         self.assertLessEqual(set(given), LAUNCH_ARGS)
-        self.assertEqual(given, {'scene': a.scene, 'fidelity': 'coarse', 'f': '1.5', 'drive': 'towed', 'dem_threads': '2',
-                                 'mu': '0.05', 'load': '800', 'speed': '0.5', 'seed': '3',
+        self.assertEqual(given, {'scene': a.scene, 'fidelity': 'coarse', 'cohesion_factor': '1.5', 'drive': 'towed',
+                                 'dem_threads': '2', 'friction': '0.05', 'load': '800', 'speed': '0.5', 'seed': '3',
                                  'bag': '/tmp/o/runs/f1.5_towed.bag', 'cloud_rate': '5', 'rviz': 'false',
                                  'end_run': 'true'})
         # the result the launch file writes (bag[:-4] + '.result.yaml') is the one the sweep reads
