@@ -35,7 +35,7 @@ class Paths(unittest.TestCase):
     def test_the_core_runner_from_option_env_build_folder_or_checkout(self):
         env = {k: v for k, v in os.environ.items() if k not in ('DM_RUN_SCENE', 'DM_BUILD')}
         with mock.patch.dict(os.environ, env, clear=True):
-            self.assertEqual(paths.dm_run_scene(), os.path.join(ROOT, 'build', 'core', 'src', 'core', 'dm_run_scene'))
+            self.assertEqual(paths.dm_run_scene(), os.path.join(ROOT, 'build', 'core', 'src', 'tools', 'dm_run_scene'))
             os.environ['DM_BUILD'] = '/b'
             self.assertEqual(paths.dm_run_scene(), '/b/core/src/tools/dm_run_scene')
             os.environ['DM_RUN_SCENE'] = '/x/dm_run_scene'
