@@ -161,6 +161,11 @@ class Doe(unittest.TestCase):
                  ('text', dict(good, speed=[[10.0, 'fast'], [5.0, 15.0]]), 'speed: a value that is not a number'),
                  ('negative', dict(good, speed=[[10.0, -1.0], [5.0, 15.0]]), 'speed: a speed below 0'),
                  ('grades', dict(good, grades=[12.0, 0.0]), 'grades/cone_indices:'),
+                 # a table of an older version: its cases' cone index under the old key
+                 ('old_key', dict(good, cases=[{'grade_deg': 0.0, 'cone_index': 30.0, 'speed_made_good': 10.0}]),
+                  "cases[0]: 'cone_index' is an old name: it is 'cone_index_psi' now"),
+                 ('old_doe_table', dict(good, cases=1, cases_table=[{'grade_deg': 0.0, 'cone_index': 30.0}]),
+                  "cases_table[0]: 'cone_index' is an old name: it is 'cone_index_psi' now"),
                  ('no_speed', {'grades': [0.0]}, 'not a case table'))
         for name, doc, what in cases:
             path = os.path.join(self.tmp, name + '_table.yaml')

@@ -78,6 +78,25 @@ class Decisions(unittest.TestCase):
         st = self.states(c2_0=('simulated', 'command_limited', 24.9), c0_2=('running', None, 0.0))
         self.assertIsNone(runner.decide(self.by_cell[(1, 1)], self.doc, st))
 
+    def test_a_plan_of_an_older_version_is_refused_naming_the_old_key_and_the_new(self):
+        self.assertEqual({k for c in self.doc['cases'] for k in c} & {'cone_index', 'grade'}, set())
+        out = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, out)
+        old = dict(self.doc, cases=[dict(c) for c in self.doc['cases']])
+        old['cases'][4]['cone_index'] = old['cases'][4].pop('cone_index_psi')
+        runner.write_yaml(os.path.join(out, runner.PLAN_FILE), old)
+        with self.assertRaises(runner.RunnerError) as e:
+            runner.load_plan(out)
+        self.assertIn("%s: cases[4]: 'cone_index' is an old name: it is 'cone_index_psi' now"
+                      % os.path.join(out, runner.PLAN_FILE), str(e.exception))
+        old = dict(self.doc, refinements=[{'axis': 'grade', 'value': 5.0, 'between': [0.0, 10.0]}])
+        runner.write_yaml(os.path.join(out, runner.PLAN_FILE), old)
+        with self.assertRaisesRegex(runner.RunnerError, "refinements\\[0\\]: axis 'grade' is an old name: it is "
+                                    "'grade_deg' now"):
+            runner.load_plan(out)
+        runner.write_yaml(os.path.join(out, runner.PLAN_FILE), self.doc)
+        self.assertEqual(runner.load_plan(out)['cases'], self.doc['cases'])
+
     def test_implied_cases_never_bound_others_and_no_prune_runs_everything(self):
         st = self.states(c1_1=('implied', 'no_go', 0.0))
         self.assertIsNone(runner.decide(self.by_cell[(2, 0)], self.doc, st))
@@ -105,7 +124,7 @@ class CaseCommands(unittest.TestCase):
             given = runner.make_plan(grid, 'tiny', r, 2, 5.0, True, lambda g, c: 1.0, scenes={'soil': own})
             self.assertIsNone(runner.same_design(plain, plain))
             self.assertIn('scenes', runner.same_design(plain, given))
-            by = {(c['grade_deg'], c['cone_index']): c for c in given['cases']}
+            by = {(c['grade_deg'], c['cone_index_psi']): c for c in given['cases']}
             s = runner.case_command(given, by[(12.0, 50.0)], '/tmp/doe', 11611, dm_run_scene='/x/dm_run_scene')
             g = runner.case_command(given, by[(12.0, 300.0)], '/tmp/doe', 11611, dm_run_scene='/x/dm_run_scene')
             if r == 'roslaunch':
@@ -210,15 +229,15 @@ class Refinement(unittest.TestCase):
         # psi); CIs 30-50: 5 (at 10 deg), 50-100: 9 (at 20 deg); 100-300 is the road's
         picks = plan.refinements(grades, cis, speed, 3)
         self.assertEqual([(p[0], p[1], p[2]) for p in picks],
-                         [('cone_index', 75.0, (50.0, 100.0)), ('grade', 15.0, (10.0, 20.0)),
-                          ('cone_index', 40.0, (30.0, 50.0))])
+                         [('cone_index_psi', 75.0, (50.0, 100.0)), ('grade_deg', 15.0, (10.0, 20.0)),
+                          ('cone_index_psi', 40.0, (30.0, 50.0))])
         self.assertEqual([p[3] for p in picks], [9.0, 8.0, 5.0])
         # the road's column is not split towards the soil (100 -> 300 jumps by 12); nor a pair
         # whose halves would be under the minimum step
         self.assertNotIn(200.0, [p[1] for p in plan.refinements(grades, cis, speed, 10)])
         self.assertEqual(plan.refinements([0.0, 1.5], [50.0], [[5.0], [1.0]], 1), [])
         self.assertEqual(plan.refinements([0.0, 2.0], [50.0, 58.0], [[5.0, 6.0], [1.0, 9.0]], 2),
-                         [('grade', 1.0, (0.0, 2.0), 4.0)])
+                         [('grade_deg', 1.0, (0.0, 2.0), 4.0)])
 
     def test_a_refined_doe_runs_the_new_line_keeps_the_rest_and_resumes(self):
         tmp = tempfile.mkdtemp(prefix='dm_doe_refine_')
@@ -239,7 +258,7 @@ class Refinement(unittest.TestCase):
         self.assertEqual((t['simulated'], t['implied'], t['failed']), (4, 0, 0))
         p = runner.load_plan(out)
         self.assertEqual(p['design']['grades'], [0.0, 10.0, 20.0])
-        self.assertEqual([(r['axis'], r['value'], r['between']) for r in p['refinements']], [('grade', 15.0, [10.0, 20.0])])
+        self.assertEqual([(r['axis'], r['value'], r['between']) for r in p['refinements']], [('grade_deg', 15.0, [10.0, 20.0])])
         # the cases run before were not run again (one log line each), the new one once
         with open(os.path.join(out, 'runs', 'g0_ci300.log')) as fh:
             self.assertEqual(fh.read().count('$ '), 1)
@@ -431,7 +450,7 @@ class SlurmDoe(unittest.TestCase):
             a = load(os.path.join(local, 'doe_table.yaml'))
             self.assertEqual((a['cases'], a['simulated'], a['implied'], a['failed']), (9, 9, 0, 0))
             self.assertEqual(a['scene_files']['soil'], scene)
-            rows = {(r['grade_deg'], r['cone_index']): r for r in a['cases_table']}
+            rows = {(r['grade_deg'], r['cone_index_psi']): r for r in a['cases_table']}
             for (g, c), r in rows.items():
                 self.assertEqual(r['source'], 'simulated (%s, %s)' % (('road', 'rigid road') if c == 300 else ('soil', 'tiny')))
                 v = r['speed_made_good']

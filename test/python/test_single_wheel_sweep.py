@@ -22,10 +22,13 @@ import yaml
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 TOOL = [sys.executable, '-m', 'dem_mobility_tools.wheel.sweep']  # dm-wheel-sweep
 
-from dem_mobility_tools import paths
+from dem_mobility_tools import names, paths
 from dem_mobility_tools import sweep as dm_sweep
 from dem_mobility_tools.terramechanics import wheel_numerics as wn
 from dem_mobility_tools.wheel import sweep as sws
+
+# the soil keys: the one names of a cone index [psi] and of the cohesion factor f
+CI, F = 'cone_index_psi', 'cohesion_factor'
 
 try:
     import matplotlib  # noqa: F401
@@ -92,26 +95,26 @@ def args(**kw):
 
 class Cases(unittest.TestCase):
     def test_grid_names_and_order(self):
-        cases = sws.make_cases('ci', [60, 100], [0.1, 0.3], towed=True)
+        cases = sws.make_cases(CI, [60, 100], [0.1, 0.3], towed=True)
         self.assertEqual([c.name for c in cases], ['ci60_slip0.1', 'ci60_slip0.3', 'ci60_towed',
                                                    'ci100_slip0.1', 'ci100_slip0.3', 'ci100_towed'])
-        self.assertEqual(cases[2].params, {'soil_key': 'ci', 'soil': 60, 'drive': 'towed', 'slip': None})
-        self.assertEqual([c.name for c in sws.make_cases('f', [1.5], [0.05])], ['f1.5_slip0.05'])
+        self.assertEqual(cases[2].params, {'soil_key': 'cone_index_psi', 'soil': 60, 'drive': 'towed', 'slip': None})
+        self.assertEqual([c.name for c in sws.make_cases(F, [1.5], [0.05])], ['f1.5_slip0.05'])
         with self.assertRaises(ValueError):
-            sws.make_cases('ci', [60], [0.1, 0.1])
+            sws.make_cases(CI, [60], [0.1, 0.1])
         with self.assertRaises(ValueError):
             sws.make_cases('mu', [60], [0.1])
 
     def test_roslaunch_command(self):
         a = args(out='/data/sweep')
-        case = sws.make_cases('ci', [100], [0.2])[0]
+        case = sws.make_cases(CI, [100], [0.2])[0]
         self.assertEqual(sws.roslaunch_command(a, case, 11413), [
             'roslaunch', '-p', '11413', 'dem_mobility', 'single_wheel.launch', 'scene:=' + a.scene,
             'fidelity:=coarse', 'cone_index:=100', 'slip:=0.2', 'drive:=slip', 'dem_threads:=1',
             'bag:=/data/sweep/runs/ci100_slip0.2.bag', 'cloud_rate:=5', 'rviz:=false', 'end_run:=true'])
         # every option given, f for the soil (cohesion_factor:=), towed: only the launch file's arguments
         a = args(mu=0.05, load=800, speed=0.5, seed=3, dem_threads=2)
-        towed = sws.make_cases('f', [1.5], [], towed=True)[0]
+        towed = sws.make_cases(F, [1.5], [], towed=True)[0]
         argv = sws.roslaunch_command(a, towed, 11411)
         given = dict(x.split(':=', 1) for x in argv[5:])
         self.assertLessEqual(set(given), LAUNCH_ARGS)
@@ -127,26 +130,31 @@ class Cases(unittest.TestCase):
 
     def test_core_command(self):
         a = args(mu=0.05, fidelity='tiny')
-        case = sws.make_cases('ci', [100], [0.3])[0]
+        case = sws.make_cases(CI, [100], [0.3])[0]
         self.assertEqual(sws.core_command(a, case, 'runs/x.result.yaml'), [
             '/x/dm_run_scene', a.scene, 'fidelity=tiny', 'cone_index=100', 'wheel.slip=0.3', 'wheel.drive=slip',
             'threads=1', 'friction=0.05', '--out', os.path.abspath('runs/x.result.yaml')])
-        towed = sws.make_cases('f', [2], [], towed=True)[0]
+        towed = sws.make_cases(F, [2], [], towed=True)[0]
         self.assertEqual(sws.core_command(args(), towed, '/r.yaml')[3:5], ['cohesion_factor=2', 'wheel.drive=towed'])
 
     def test_resume_accepts_the_same_run_only(self):
         accept = sws.same_run(args(fidelity='tiny', load=1230))
-        case = sws.make_cases('ci', [100], [0.3])[0]
+        case = sws.make_cases(CI, [100], [0.3])[0]
         old = {'fidelity': 'tiny', 'drive': 'slip', 'slip_commanded': 0.3, 'requested_cone_index_psi': 100,
                'cohesion_factor': 3.2, 'load_mass': 1230.0}
         self.assertTrue(accept(case, old))
         for change in ({'fidelity': 'coarse'}, {'slip_commanded': 0.2}, {'requested_cone_index_psi': 60},
                        {'load_mass': 1000.0}, {'drive': 'towed'}):
             self.assertFalse(accept(case, dict(old, **change)), change)
-        f_case = sws.make_cases('f', [3.2], [0.3])[0]
+        f_case = sws.make_cases(F, [3.2], [0.3])[0]
         self.assertFalse(accept(f_case, old))  # made from a cone index, not f directly
         del old['requested_cone_index_psi']
         self.assertTrue(accept(f_case, old))
+        # a result of an older version (its requested cone index under the old name) is refused, naming it
+        with self.assertRaises(names.OldNameError) as e:
+            accept(case, dict(old, requested_ci=100))
+        self.assertIn("/tmp/o/runs/ci100_slip0.3.result.yaml: 'requested_ci' is an old name: it is "
+                      "'requested_cone_index_psi' now", str(e.exception))
 
     def test_check(self):
         self.assertIsNone(sws.check(None, {'status': 'ok', 'window_samples': 3}))
@@ -167,19 +175,21 @@ class Summary(unittest.TestCase):
               'dp_over_w_std': 0.01, 'torque_over_wr_std': 0.01, 'sinkage_std': 0.001}
 
     def test_f_without_a_table_has_no_reference(self):
-        cases = sws.make_cases('f', [2.0], [0.2])
+        cases = sws.make_cases(F, [2.0], [0.2])
         res = dict(self.RESULT, cohesion_factor=2.0, slip=0.2, dp_over_w=0.3, torque_over_wr=0.4, sinkage=0.05,
                    cone_index_psi='unknown: f given directly and no calibration table at this particle size')
-        s = sws.soil_summary('f', 2.0, [outcome(cases[0], res)])
+        s = sws.soil_summary(F, 2.0, [outcome(cases[0], res)])
+        self.assertEqual((s['soil'], s['cohesion_factor']), ('f2', 2.0))
+        self.assertNotIn('f', s)
         self.assertIsNone(s['reference'])
         self.assertIn('unknown: f given directly', s['no_reference'])
         self.assertEqual(s['points']['dp_over_w'], [0.3])
 
     def test_f_with_a_table_uses_its_cone_index(self):
-        cases = sws.make_cases('f', [2.0], [0.2])
+        cases = sws.make_cases(F, [2.0], [0.2])
         res = dict(self.RESULT, cohesion_factor=2.0, slip=0.2, dp_over_w=0.3, torque_over_wr=0.4, sinkage=0.05,
                    cone_index_psi=80.0)
-        s = sws.soil_summary('f', 2.0, [outcome(cases[0], res)])
+        s = sws.soil_summary(F, 2.0, [outcome(cases[0], res)])
         v = wn.vti(80.0, 0.25, 1.0, 10000.0)
         self.assertEqual(s['cone_index_psi'], 80.0)
         self.assertAlmostEqual(s['reference']['vti_dp_over_w'][0], wn.vti_dp_over_w(0.2, v['nc'], 0.25, 1.0, v['ssp']),
@@ -188,7 +198,7 @@ class Summary(unittest.TestCase):
                                places=4)
 
     def test_points_sorted_sunk_kept_failed_listed(self):
-        cases = sws.make_cases('ci', [50], [0.4, 0.1, 0.2, 0.3], towed=True)
+        cases = sws.make_cases(CI, [50], [0.4, 0.1, 0.2, 0.3], towed=True)
         outs = [outcome(cases[0], dict(self.RESULT, status='sunk', error='sank', window_samples=0, slip=0.0,
                                        dp_over_w=0.0, torque_over_wr=0.0, sinkage=0.0, slip_commanded=0.4,
                                        cone_index_psi=50.0)),
@@ -199,7 +209,9 @@ class Summary(unittest.TestCase):
                                        cone_index_psi=50.0)),
                 outcome(cases[4], dict(self.RESULT, slip=-0.05, dp_over_w=-0.08, torque_over_wr=0.0, sinkage=0.05,
                                        cone_index_psi=50.0))]
-        s = sws.soil_summary('ci', 50, outs)
+        s = sws.soil_summary(CI, 50, outs)
+        self.assertEqual((s['soil'], s['requested_cone_index_psi'], s['cone_index_psi']), ('ci50', 50, 50.0))
+        self.assertNotIn('ci', s)
         p = s['points']
         self.assertEqual(p['name'], ['ci50_slip0.1', 'ci50_slip0.3', 'ci50_slip0.4'])
         self.assertEqual(p['status'], ['ok', 'ok', 'sunk'])

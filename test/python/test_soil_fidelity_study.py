@@ -11,7 +11,8 @@ import tempfile
 import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from dem_mobility_tools.fidelity import study
+from dem_mobility_tools import names
+from dem_mobility_tools.fidelity import plot, study
 
 
 def rows_of(runs):
@@ -22,7 +23,7 @@ def rows_of(runs):
         for level in study.LEVEL_ORDER:
             if level in by_level:
                 v, wall = by_level[level]
-                rows.append(dict(grade=g, cone_index=ci, level=level, speed_made_good=v, wall_time=wall,
+                rows.append(dict(grade_deg=g, cone_index_psi=ci, level=level, speed_made_good=v, wall_time=wall,
                                  reference=finest, error_vs_finest=abs(v - by_level[finest][0])))
     return rows
 
@@ -83,18 +84,28 @@ class Resume(unittest.TestCase):
         shutil.rmtree(self.tmp, ignore_errors=True)
 
     def args(self, **kw):
-        a = dict(scene=self.scene, duration=40.0, runner='core', resume=False)
+        a = dict(scene=self.scene, duration=40.0, runner='core', resume=False, out=self.tmp)
         a.update(kw)
         return argparse.Namespace(**a)
 
     def test_only_a_result_of_the_same_case_is_kept(self):
         accept = study.same_run(self.args())
-        case = {'level': 'coarse', 'grade': 0.0, 'ci': 50.0}
+        case = {'level': 'coarse', 'grade_deg': 0.0, 'cone_index_psi': 50.0}
         good = {'scene': self.scene, 'fidelity': 'coarse', 'grade_deg': 0, 'requested_cone_index_psi': 50}
         self.assertTrue(accept(case, good))
         for key, v in (('scene', '/elsewhere/soil_slope.yaml'), ('fidelity', 'tiny'), ('grade_deg', 12),
                        ('requested_cone_index_psi', 100), ('grade_deg', None)):
             self.assertFalse(accept(case, dict(good, **{key: v})), key)
+
+    def test_a_result_of_an_older_version_is_refused_naming_the_file_and_the_new_key(self):
+        accept = study.same_run(self.args())
+        case = {'level': 'coarse', 'grade_deg': 0.0, 'cone_index_psi': 50.0}
+        old = {'scene': self.scene, 'fidelity': 'coarse', 'grade_deg': 0, 'requested_ci': 50}
+        with self.assertRaises(names.OldNameError) as e:
+            accept(case, old)
+        self.assertEqual(str(e.exception).split(' (')[0], "%s: 'requested_ci' is an old name: it is "
+                         "'requested_cone_index_psi' now" % os.path.join(self.tmp, 'runs', 'coarse_g0_ci50.result.yaml'))
+
 
     def test_a_resume_with_another_driving_time_is_refused_naming_it(self):
         study.check_options(self.args(), self.tmp)
@@ -108,7 +119,7 @@ class Resume(unittest.TestCase):
 
     def test_a_run_keeps_a_checkpoint_and_a_stopped_one_is_taken_up_from_it(self):
         a = self.args(dm_run_scene='/bin/dm_run_scene', dem_threads=2, checkpoint_every=600.0)
-        case = {'level': 'coarse', 'grade': 0.0, 'ci': 50.0}
+        case = {'level': 'coarse', 'grade_deg': 0.0, 'cone_index_psi': 50.0}
         result = os.path.join(self.tmp, 'coarse_g0_ci50.result.yaml')
         ckpt = os.path.join(self.tmp, 'coarse_g0_ci50.ckpt')
         cmd = study.core_command(a, case, result)
@@ -152,6 +163,23 @@ class Resume(unittest.TestCase):
         self.assertNotIn('Traceback', text)
         self.assertIn('interrupted', text)
         self.assertIn('--resume goes on (a stopped run from its checkpoint)', text)
+
+
+class PlotOfMeasuredRuns(unittest.TestCase):
+    """dm-plot-fidelity's rows from a file of measured runs; a file with the old keys is refused."""
+
+    def test_each_run_is_compared_with_its_cases_finest_and_old_keys_are_refused(self):
+        runs = [{'grade_deg': 12, 'cone_index_psi': 100, 'level': 'tiny', 'speed_made_good': 11.0, 'wall_time': 10},
+                {'grade_deg': 12, 'cone_index_psi': 100, 'level': 'coarse', 'speed_made_good': 12.5, 'wall_time': 50},
+                {'grade_deg': 0, 'cone_index_psi': 50, 'level': 'tiny', 'speed_made_good': 8.0, 'wall_time': 9}]
+        rows = plot.rows_of(runs, 'runs.yaml')
+        self.assertEqual([(r['reference'], r['error_vs_finest']) for r in rows],
+                         [('coarse', 1.5), ('coarse', 0.0), ('tiny', 0.0)])
+        old = [dict(runs[0])]
+        old[0]['grade'] = old[0].pop('grade_deg')
+        with self.assertRaises(SystemExit) as e:
+            plot.rows_of(old, 'runs.yaml')
+        self.assertIn("runs.yaml: runs: 'grade' is an old name: it is 'grade_deg' now", str(e.exception))
 
 
 if __name__ == '__main__':

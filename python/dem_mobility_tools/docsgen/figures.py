@@ -82,7 +82,7 @@ def cone_sweep_04(root):
     t005 = _load(root, 'config/calibration/cone_index_mu0.05_d0.06.yaml')
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 5))
-    f = [r['f'] for r in rows]
+    f = [r['cohesion_factor'] for r in rows]
     ax.errorbar(f, [r['ci_mu01'] for r in rows], yerr=[r['std_mu01'] for r in rows], fmt='o', capsize=3,
                 label='runs, mu = 0.1 (window std)')
     line = ax.plot(f, [r['ci_mu005'] for r in rows], 's', mfc='none', label='runs, mu = 0.05')[0]

@@ -28,6 +28,7 @@ from ..terramechanics import nrmm
 from . import maps, plan, raster, runner, slurm
 
 from .. import paths
+from ..names import OldNameError, refuse_old_keys
 from ..paths import CONFIG, ROOT
 NRMM_VEHICLE = os.path.join(CONFIG, 'vehicles', 'hmmwv', 'nrmm.yaml')
 COSTS = os.path.join(CONFIG, 'doe', 'run_costs.yaml')
@@ -101,7 +102,7 @@ def cells_of(a):
 
 def write_table(path_stem, grid, rows, provenance):
     """The case table as CSV and YAML (with provenance)."""
-    cols = ['grade_deg', 'cone_index', 'speed_made_good', 'speed_made_good_mph', 'status', 'source']
+    cols = ['grade_deg', 'cone_index_psi', 'speed_made_good', 'speed_made_good_mph', 'status', 'source']
     with open(path_stem + '.csv', 'w', newline='') as fh:
         w = csv.writer(fh)
         w.writerow(cols)
@@ -110,7 +111,7 @@ def write_table(path_stem, grid, rows, provenance):
     doc = dict(provenance, grades=grid.grades, cone_indices=grid.cone_indices,
                speed=[[None] * len(grid.cone_indices) for _ in grid.grades], cases=rows)
     for r in rows:
-        doc['speed'][grid.grades.index(r['grade_deg'])][grid.cone_indices.index(r['cone_index'])] = r['speed_made_good']
+        doc['speed'][grid.grades.index(r['grade_deg'])][grid.cone_indices.index(r['cone_index_psi'])] = r['speed_made_good']
     with open(path_stem + '.yaml', 'w') as fh:
         yaml.safe_dump(doc, fh, sort_keys=False)
     return path_stem + '.yaml'
@@ -143,6 +144,14 @@ def read_table(path):
         s = np.array([[np.nan if v is None else float(v) for v in row] for row in rows], dtype=float)
     except (TypeError, ValueError) as e:
         raise UsageError('%s: speed: a value that is not a number (%s)' % (path, e))
+    # the rows: nrmm_table's `cases`, doe_table's `cases_table` (its `cases` is their number)
+    for where in ('cases', 'cases_table'):
+        rows = doc.get(where)
+        for k, row in enumerate(rows if isinstance(rows, list) else []):
+            try:
+                refuse_old_keys(row, path, '%s[%d]' % (where, k))
+            except OldNameError as e:
+                raise UsageError(str(e))
     if np.isnan(s).any():
         raise UsageError('%s: the table has cases without a speed (the DOE is not finished)' % path)
     if (s < 0).any() or not np.isfinite(s).all():
@@ -187,7 +196,7 @@ def cmd_nrmm(a):
     for g in grid.grades:
         for c in grid.cone_indices:
             r = v.speed(g, c)
-            rows.append({'grade_deg': g, 'cone_index': c, 'speed_made_good': round(r['speed'], 6),
+            rows.append({'grade_deg': g, 'cone_index_psi': c, 'speed_made_good': round(r['speed'], 6),
                          'speed_made_good_mph': round(r['speed'] / maps.MPH, 4), 'status': r['status'],
                          'source': 'nrmm (%s)' % r['limit']})
     prov = {'model': 'nrmm', 'vehicle': os.path.abspath(a.vehicle), 'commit': git_commit(ROOT),
@@ -228,7 +237,7 @@ def cmd_map(a):
     raster.write_geotiff(os.path.join(a.out, 'cells_max_slope_deg.tif'), slope, cells.gt, cells.wkt, 'max slope [deg]')
     raster.write_geotiff(os.path.join(a.out, 'cells_min_ci_psi.tif'), ci, cells.gt, cells.wkt, 'min CI [psi]')
     beyond = int(np.sum(np.isnan(speed) & ~np.isnan(slope)))
-    report = {'table': os.path.abspath(a.table), 'elevation': os.path.abspath(a.elevation), 'cone_index': source,
+    report = {'table': os.path.abspath(a.table), 'elevation': os.path.abspath(a.elevation), 'cone_index_source': source,
               'cells': list(cells.shape), 'cell_size': cells.cell_size, 'oversample': cells.oversample,
               'reprojected_to_utm': cells.reprojected, 'interpolation_wall_time': round(t_map, 4),
               'cells_beyond_the_table': beyond, 'outputs': out}
@@ -489,7 +498,7 @@ def cmd_run(a):
                                         lambda g, c: run_cost(costs, a.level, v.speed(g, c)['status'], c))
         for axis, value, between, jump in picks:
             print('doe: refinement: %s %g between %g and %g (the speed changes by up to %.2f m/s across them)' % (
-                'grade' if axis == 'grade' else 'cone index', value, between[0], between[1], jump))
+                'grade' if axis == 'grade_deg' else 'cone index', value, between[0], between[1], jump))
         if picks:
             interrupted = run_pending(a, doc)
             if interrupted is None:

@@ -142,7 +142,7 @@ def replay(grid, outcome_of):
 def refinements(grades, cone_indices, speed, count, min_grade_step=1.0, min_ci_step=5.0,
                 road_ci=ROAD_CONE_INDEX):
     """Up to `count` new grid lines where speed-made-good changes fastest between neighbours:
-    [(axis 'grade' or 'cone_index', value, (lo, hi), jump)], the largest jump first. A pair of
+    [(axis 'grade_deg' or 'cone_index_psi', value, (lo, hi), jump)], the largest jump first. A pair of
     neighbouring grades (cone indices) is split at its midpoint; its jump is the largest |speed
     difference| across it over the other axis. A pair whose halves would be narrower than the
     minimum step (1 deg, 5 psi) is not split, nor the pair between the strongest soil and the
@@ -152,11 +152,11 @@ def refinements(grades, cone_indices, speed, count, min_grade_step=1.0, min_ci_s
     for i in range(len(g) - 1):
         if g[i + 1] - g[i] >= 2.0 * min_grade_step:
             jump = max(abs(speed[i + 1][j] - speed[i][j]) for j in range(len(c)))
-            candidates.append((jump, 'grade', 0.5 * (g[i] + g[i + 1]), (g[i], g[i + 1])))
+            candidates.append((jump, 'grade_deg', 0.5 * (g[i] + g[i + 1]), (g[i], g[i + 1])))
     for j in range(len(c) - 1):
         if c[j + 1] >= road_ci or c[j + 1] - c[j] < 2.0 * min_ci_step:
             continue
         jump = max(abs(speed[i][j + 1] - speed[i][j]) for i in range(len(g)))
-        candidates.append((jump, 'cone_index', 0.5 * (c[j] + c[j + 1]), (c[j], c[j + 1])))
+        candidates.append((jump, 'cone_index_psi', 0.5 * (c[j] + c[j + 1]), (c[j], c[j + 1])))
     candidates.sort(key=lambda x: (-x[0], x[1], x[2]))
     return [(axis, value, between, jump) for jump, axis, value, between in candidates[:max(0, count)] if jump > 0.0]

@@ -29,6 +29,7 @@ import time
 
 import yaml
 
+from ..names import OLD, OldNameError, refuse_old_keys
 from ..paths import ROOT, tool_command
 from ..runs import free_port, read_result as _read_result, scene_command
 from ..sweep.args import git_commit
@@ -90,7 +91,7 @@ def make_plan(grid, level, runner, dem_threads, duration, prune, cost_of, proven
     cases = []
     for k, (i, j) in enumerate(grid.order()):
         g, c = grid.grades[i], grid.cone_indices[j]
-        cases.append({'index': k, 'name': case_name(g, c), 'cell': [i, j], 'grade_deg': g, 'cone_index': c,
+        cases.append({'index': k, 'name': case_name(g, c), 'cell': [i, j], 'grade_deg': g, 'cone_index_psi': c,
                       'scene': 'road' if c >= plan.ROAD_CONE_INDEX else 'soil',
                       'estimated_cost': round(float(cost_of(g, c)), 1)})
     doc = {'grades': grid.grades, 'cone_indices': grid.cone_indices, 'level': level, 'runner': runner,
@@ -132,14 +133,14 @@ def refine_plan(out, doc, total, cost_of):
     if open_cases:
         raise RunnerError('--refine: the grid is not finished (%s): refinement goes by the finished table'
                           % ', '.join(open_cases[:5]))
-    speed = {(r['grade_deg'], r['cone_index']): r['speed_made_good'] for r in table_rows(out, doc, states)}
+    speed = {(r['grade_deg'], r['cone_index_psi']): r['speed_made_good'] for r in table_rows(out, doc, states)}
     g, c = doc['grades'], doc['cone_indices']
     matrix = [[speed[(x, y)] for y in c] for x in g]
     picks = plan.refinements(g, c, matrix, total - len(done))
     if not picks:
         return doc, []
-    grades = sorted(g + [v for axis, v, _, _ in picks if axis == 'grade'])
-    cis = sorted(c + [v for axis, v, _, _ in picks if axis == 'cone_index'])
+    grades = sorted(g + [v for axis, v, _, _ in picks if axis == 'grade_deg'])
+    cis = sorted(c + [v for axis, v, _, _ in picks if axis == 'cone_index_psi'])
     own = ('grades', 'cone_indices', 'level', 'runner', 'dem_threads', 'duration', 'prune', 'scenes', 'commit',
            'created', 'cases', 'design', 'refinements')
     new = make_plan(plan.Grid(grades, cis), doc['level'], doc['runner'], doc['dem_threads'], doc['duration'],
@@ -173,6 +174,15 @@ def load_plan(out):
         raise RunnerError('%s: not a DOE plan (%s)' % (path, e))
     if not isinstance(doc, dict) or not isinstance(doc.get('cases'), list):
         raise RunnerError('%s: not a DOE plan (no cases)' % path)
+    try:
+        for k, case in enumerate(doc['cases']):
+            refuse_old_keys(case, path, 'cases[%d]' % k)
+        for k, line in enumerate(doc.get('refinements') or []):
+            if isinstance(line, dict) and line.get('axis') in OLD:
+                raise OldNameError('%s: refinements[%d]: axis %r is an old name: it is %r now (a file written by '
+                                   'an older version of the tools)' % (path, k, line['axis'], OLD[line['axis']]))
+    except OldNameError as e:
+        raise RunnerError(str(e))
     return doc
 
 
@@ -316,7 +326,7 @@ def case_command(doc, case, out, port, dm_run_scene=None):
     base = result[:-len('.result.yaml')]
     params = [('grade_deg', float(case['grade_deg'])), ('duration', float(doc['duration']) if doc.get('duration') else None)]
     if case['scene'] == 'soil':
-        params += [('fidelity', doc['level']), ('cone_index', float(case['cone_index'])),
+        params += [('fidelity', doc['level']), ('cone_index', float(case['cone_index_psi'])),
                    ('dem_threads', int(doc['dem_threads']))]
     # roslaunch takes the launch file's own scene unless the plan has its own; the core runner a file
     scene = own_scene(doc, case['scene']) if doc['runner'] == 'roslaunch' else scene_file(doc, case['scene'])
@@ -372,10 +382,10 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
             write_yaml(result_path(out, case), {
                 'kind': 'doe_implied', 'status': IMPLIED, 'simulated': False, 'implied_status': status,
                 'speed_made_good': speed, 'speed_made_good_mph': speed / 0.44704, 'implied_by': by['name'],
-                'grade_deg': case['grade_deg'], 'cone_index_psi': case['cone_index'], 'fidelity': doc['level'],
+                'grade_deg': case['grade_deg'], 'cone_index_psi': case['cone_index_psi'], 'fidelity': doc['level'],
                 'made': utc_now(),
                 'why': ('an easier case (grade %g deg, CI %g psi) was stuck' if status == plan.NO_GO else
-                        'a harder case (grade %g deg, CI %g psi) reached the command') % (by['grade_deg'], by['cone_index'])})
+                        'a harder case (grade %g deg, CI %g psi) reached the command') % (by['grade_deg'], by['cone_index_psi'])})
             print('%s: implied %s by %s (not simulated)' % (case['name'], status, by['name']), file=stream)
             return 0
         for p in (result_path(out, case),):
@@ -417,7 +427,7 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
             os._exit(0)
         write_yaml(result_path(out, case), {
             'kind': 'doe_case', 'status': 'interrupted', 'grade_deg': case['grade_deg'],
-            'cone_index_psi': case['cone_index'], 'error': 'the case was stopped (signal %d) after %.0f s; see %s'
+            'cone_index_psi': case['cone_index_psi'], 'error': 'the case was stopped (signal %d) after %.0f s; see %s'
             % (signum, time.time() - t0, log)})
         with contextlib.suppress(OSError):
             os.remove(marker_path(out, case))
@@ -461,7 +471,7 @@ def record_failure(out, doc, case, error, kind='doe_case', status='error'):
         if states[case['index']][0] in ('simulated', 'implied'):
             return False
         write_yaml(result_path(out, case), {'kind': kind, 'status': status, 'grade_deg': case['grade_deg'],
-                                            'cone_index_psi': case['cone_index'], 'error': error})
+                                            'cone_index_psi': case['cone_index_psi'], 'error': error})
         with contextlib.suppress(OSError):
             os.remove(marker_path(out, case))
     return True
@@ -474,7 +484,7 @@ def table_rows(out, doc, states=None):
     rows = []
     for case in doc['cases']:
         state, r = states[case['index']]
-        row = {'grade_deg': case['grade_deg'], 'cone_index': case['cone_index'], 'state': state,
+        row = {'grade_deg': case['grade_deg'], 'cone_index_psi': case['cone_index_psi'], 'state': state,
                'speed_made_good': None, 'speed_made_good_mph': None, 'status': None, 'source': None,
                'error_estimate': None, 'wall_time': None, 'calibration_table': None, 'commit': None, 'error': None}
         if state == 'simulated':
@@ -491,7 +501,7 @@ def table_rows(out, doc, states=None):
         elif state == 'failed':
             row['error'] = (r or {}).get('error') or verdict(case, r) or 'the run left no result'
         rows.append(row)
-    rows.sort(key=lambda x: (x['grade_deg'], x['cone_index']))
+    rows.sort(key=lambda x: (x['grade_deg'], x['cone_index_psi']))
     return rows
 
 
@@ -499,7 +509,7 @@ def write_doe_table(out, doc, rows):
     """doe_table.csv and doe_table.yaml (the speed matrix that doe map reads, cases without a speed
     as null) with provenance."""
     import csv
-    cols = ['grade_deg', 'cone_index', 'speed_made_good', 'speed_made_good_mph', 'status', 'source', 'error_estimate',
+    cols = ['grade_deg', 'cone_index_psi', 'speed_made_good', 'speed_made_good_mph', 'status', 'source', 'error_estimate',
             'wall_time', 'state', 'error']
     stem = os.path.join(out, 'doe_table')
     with open(stem + '.csv', 'w', newline='') as fh:
@@ -510,7 +520,7 @@ def write_doe_table(out, doc, rows):
     grades, cis = doc['grades'], doc['cone_indices']
     speed = [[None] * len(cis) for _ in grades]
     for r in rows:
-        speed[grades.index(r['grade_deg'])][cis.index(r['cone_index'])] = r['speed_made_good']
+        speed[grades.index(r['grade_deg'])][cis.index(r['cone_index_psi'])] = r['speed_made_good']
     tables = sorted({r['calibration_table'] for r in rows if r['calibration_table']})
     commits = sorted({r['commit'] for r in rows if r['commit']})
     n_sim = sum(1 for r in rows if r['state'] == 'simulated')

@@ -28,7 +28,7 @@ import sys
 
 import yaml
 
-from .. import paths
+from .. import names, paths
 from .. import sweep as dm_sweep
 from ..paths import ROOT
 from ..runs import scene_command
@@ -52,12 +52,13 @@ def parse_cases(text):
 
 
 def case_name(p):
-    return '%s_g%g_ci%g' % (p['level'], p['grade'], p['ci'])
+    return '%s_g%g_ci%g' % (p['level'], p['grade_deg'], p['cone_index_psi'])
 
 
 def case_params(a, case):
     """A case's parameters of soil_slope.launch (runs.LAUNCHES)."""
-    return [('fidelity', case['level']), ('grade_deg', float(case['grade'])), ('cone_index', float(case['ci'])),
+    return [('fidelity', case['level']), ('grade_deg', float(case['grade_deg'])),
+            ('cone_index', float(case['cone_index_psi'])),
             ('dem_threads', a.dem_threads), ('duration', float(a.duration))]
 
 
@@ -98,13 +99,15 @@ def check(case, result):
 
 
 def same_run(a):
-    """accept(case, old result) for --resume: a result of this scene, level, grade and cone index."""
+    """accept(case, old result) for --resume: a result of this scene, level, grade and cone index;
+    names.OldNameError for a result of an older version (a key under its old name)."""
     def accept(case, old):
+        names.refuse_old_keys(old, os.path.join(a.out, 'runs', case_name(case) + '.result.yaml'))
         try:
             return (os.path.realpath(str(old.get('scene'))) == os.path.realpath(a.scene)
                     and old.get('fidelity') == case['level']
-                    and abs(float(old.get('grade_deg')) - case['grade']) < 1e-9
-                    and abs(float(old.get('requested_cone_index_psi')) - case['ci']) < 1e-9)
+                    and abs(float(old.get('grade_deg')) - case['grade_deg']) < 1e-9
+                    and abs(float(old.get('requested_cone_index_psi')) - case['cone_index_psi']) < 1e-9)
         except (TypeError, ValueError):
             return False
     return accept
@@ -133,7 +136,7 @@ def summarize(sweep, cases_gs):
     for g, ci in cases_gs:
         runs = {}
         for o in sweep.outcomes:
-            if o.case['grade'] == g and o.case['ci'] == ci and o.ok:
+            if o.case['grade_deg'] == g and o.case['cone_index_psi'] == ci and o.ok:
                 r = o.result
                 runs[o.case['level']] = {
                     'speed_made_good': number(r.get('speed_made_good')),
@@ -154,7 +157,7 @@ def summarize(sweep, cases_gs):
             x = runs[level]
             x['reference'] = finest
             x['error_vs_finest'] = abs(x['speed_made_good'] - runs[finest]['speed_made_good'])
-            rows.append(dict(grade=g, cone_index=ci, level=level, **x))
+            rows.append(dict(grade_deg=g, cone_index_psi=ci, level=level, **x))
     return rows
 
 
@@ -166,10 +169,10 @@ def level_summary(rows, tolerance=1.0):
     that ran one case only still rules out a candidate that is off in that case). The choice is
     'provisional' while the chosen level is itself the finest run in some case (nothing finer to
     compare it with there)."""
-    cases = sorted({(r['grade'], r['cone_index']) for r in rows})
+    cases = sorted({(r['grade_deg'], r['cone_index_psi']) for r in rows})
     ran = {}
     for r in rows:
-        ran.setdefault(r['level'], {})[(r['grade'], r['cone_index'])] = r
+        ran.setdefault(r['level'], {})[(r['grade_deg'], r['cone_index_psi'])] = r
     complete = [l for l in LEVEL_ORDER if l in ran and all(c in ran[l] for c in cases)]
     finest = {c: next(l for l in LEVEL_ORDER if l in ran and c in ran[l]) for c in cases}
     levels = {}
@@ -213,7 +216,7 @@ def write_table(rows, path):
         fh.write('|---|---|---|---|---|---|---|---|---|---|---|\n')
         for r in rows:
             fh.write('| %g | %g | %s | %g | %d | %.3f | %s | %s | %.0f (%.0f) | %.2f | %.3f |\n' % (
-                r['grade'], r['cone_index'], r['level'], r['particle_diameter'], r['particles'], r['speed_made_good'],
+                r['grade_deg'], r['cone_index_psi'], r['level'], r['particle_diameter'], r['particles'], r['speed_made_good'],
                 r['status'], 'reference' if r['level'] == r['reference'] else '%.3f' % r['error_vs_finest'],
                 r['wall_time'], r['prepare_wall_time'], r['simulated_time'], r['patch_density_ratio']))
 
@@ -274,21 +277,21 @@ def plot_histories(runs_dir, names, path):
 
 def plot(rows, path, unfinished=()):
     """Speed-made-good against wall time, a line per case; `unfinished`: runs stopped before their
-    verdict (rows with grade, cone_index, level, wall_time and the speed reached, speed_reached),
+    verdict (rows with grade_deg, cone_index_psi, level, wall_time and the speed reached, speed_reached),
     drawn as open markers with an arrow up: the speed-made-good is at least that, the wall time
     more than that."""
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    for key in sorted({(r['grade'], r['cone_index']) for r in list(rows) + list(unfinished)}):
-        rs = [r for r in rows if (r['grade'], r['cone_index']) == key]
+    for key in sorted({(r['grade_deg'], r['cone_index_psi']) for r in list(rows) + list(unfinished)}):
+        rs = [r for r in rows if (r['grade_deg'], r['cone_index_psi']) == key]
         line, = ax.plot([r['wall_time'] for r in rs], [r['speed_made_good'] for r in rs], 'o-',
                         label='%g deg, CI %g psi' % key)
         for r in rs:
             ax.annotate(r['level'] + (' (ref)' if r['level'] == r['reference'] else ''),
                         (r['wall_time'], r['speed_made_good']), textcoords='offset points', xytext=(5, 5), fontsize=8)
-        for u in [u for u in unfinished if (u['grade'], u['cone_index']) == key]:
+        for u in [u for u in unfinished if (u['grade_deg'], u['cone_index_psi']) == key]:
             x, y = u['wall_time'], u['speed_reached']
             if rs:  # (dotted: the case's line to a bound, not to a value)
                 ax.plot([rs[-1]['wall_time'], x], [rs[-1]['speed_made_good'], y], ':', color=line.get_color())
@@ -313,7 +316,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('--scene', default=os.path.join(ROOT, 'config', 'scenes', 'soil_slope.yaml'))
     ap.add_argument('--levels', default='tiny,coarse', help='fidelity levels (default tiny,coarse)')
-    ap.add_argument('--cases', type=parse_cases, default=parse_cases('12:100,0:50'), help='GRADE:CI pairs')
+    ap.add_argument('--cases', type=parse_cases, default=parse_cases('12:100,0:50'),
+                    help='GRADE:CI pairs: grade [deg], cone index [psi] (default 12:100,0:50)')
     ap.add_argument('--duration', type=float, default=40.0, help='longest driving time [s] (the run ends when steady)')
     ap.add_argument('--jobs', type=int, default=1)
     ap.add_argument('--dem-threads', type=int, default=1)
@@ -333,7 +337,7 @@ def main(argv=None):
     bad = [l for l in levels if l not in LEVEL_ORDER]
     if bad:
         ap.error('unknown level(s) %s (have %s)' % (', '.join(bad), ', '.join(LEVEL_ORDER)))
-    params = [dict(level=l, grade=g, ci=ci) for g, ci in a.cases for l in levels]
+    params = [dict(level=l, grade_deg=g, cone_index_psi=ci) for g, ci in a.cases for l in levels]
     cases = dm_sweep.cases(params, name=case_name)
     if a.runner == 'core':
         a.dm_run_scene = paths.dm_run_scene(a.dm_run_scene)
@@ -348,6 +352,8 @@ def main(argv=None):
                                    jobs=a.jobs,
                                    port=a.port, timeout=a.timeout, check=check, accept_status=STATUSES,
                                    summary=os.path.join(a.out, 'sweep.yaml'))
+    except names.OldNameError as e:
+        sys.exit('dm-fidelity-study: --resume: %s' % e)
     except KeyboardInterrupt:  # (Ctrl-C or SIGTERM: the runs were stopped and the summary written)
         sys.exit('dm-fidelity-study: interrupted; the finished runs are in %s; the same command with '
                  '--resume goes on%s' % (os.path.join(a.out, 'runs'),

@@ -199,7 +199,7 @@ class Vehicle:
         if not (math.isfinite(ci_psi) and ci_psi > 0.0):
             raise NrmmError('cone index %r psi: expected a positive number' % ci_psi)
         th = math.radians(grade_deg)
-        out = {'grade_deg': grade_deg, 'cone_index': ci_psi, 'vci1': self.vci1()}
+        out = {'grade_deg': grade_deg, 'cone_index_psi': ci_psi, 'vci1': self.vci1()}
         n_c, s_sp, mr = self.vti(ci_psi, th)
         out.update(clay_numeric=n_c, self_propelled_slip=s_sp, motion_resistance=mr)
         if ci_psi < out['vci1']:

@@ -2,13 +2,18 @@
 slip beside the empirical reference band, sinkage against slip, and each soil's histories."""
 import os
 
+from .. import names
 from ..terramechanics import wheel_numerics as wn
 
 HISTORY_KEYS = ('dp_over_w', 'torque_over_wr', 'sinkage')
 
 
+# a soil's label (and its cases' file names): ci100 for a cone index of 100 psi, f1.5 for f = 1.5
+LABEL_PREFIX = {names.CONE_INDEX: 'ci', names.COHESION_FACTOR: 'f'}
+
+
 def soil_label(soil_key, value):
-    return '%s%g' % (soil_key, value)
+    return '%s%g' % (LABEL_PREFIX[soil_key], value)
 
 
 def _title(doc, what):

@@ -32,13 +32,13 @@ import time
 
 import yaml
 
-from .. import paths
+from .. import names, paths
 from .. import sweep as dm_sweep
 from ..paths import ROOT
 from ..runs import scene_command
 from ..sweep.args import floats, keep_options, ros_package, sha256
 from ..terramechanics import wheel_numerics as wn
-from .plots import plots, soil_label  # noqa: F401
+from .plots import LABEL_PREFIX, plots, soil_label  # noqa: F401
 
 PROG = 'dm-wheel-sweep'
 
@@ -64,9 +64,10 @@ def case_name(p):
 
 
 def make_cases(soil_key, soils, slips, towed=False):
-    """Per soil (cone index [psi] or f, in the order given) the slips, then the towed run."""
-    if soil_key not in ('ci', 'f'):
-        raise ValueError('soil key %r: expected ci or f' % soil_key)
+    """Per soil (soil_key cone_index_psi: cone indices [psi]; cohesion_factor: f; in the order given)
+    the slips, then the towed run."""
+    if soil_key not in (names.CONE_INDEX, names.COHESION_FACTOR):
+        raise ValueError('soil key %r: expected %s or %s' % (soil_key, names.CONE_INDEX, names.COHESION_FACTOR))
     params = []
     for v in soils:
         params += [{'soil_key': soil_key, 'soil': v, 'drive': 'slip', 'slip': s} for s in slips]
@@ -82,7 +83,7 @@ def bag_path(out, name):
 def case_params(a, case):
     """A case's parameters of single_wheel.launch (runs.LAUNCHES), None where the scene's value holds."""
     return [('fidelity', a.fidelity),
-            ('cone_index' if case['soil_key'] == 'ci' else 'cohesion_factor', float(case['soil'])),
+            ('cone_index' if case['soil_key'] == names.CONE_INDEX else 'cohesion_factor', float(case['soil'])),
             ('slip', float(case['slip']) if case['drive'] == 'slip' else None),
             ('drive', case['drive']),
             ('dem_threads', a.dem_threads),
@@ -128,11 +129,12 @@ def same_run(a):
     """accept(case, old result) for resume: the same level, soil, drive, slip, and mu, load and
     speed where given."""
     def accept(case, old):
+        names.refuse_old_keys(old, os.path.join(a.out, 'runs', case_name(case) + '.result.yaml'))
         if old.get('fidelity') != a.fidelity or old.get('drive') != case['drive']:
             return False
         if case['drive'] == 'slip' and not _same(old.get('slip_commanded'), case['slip']):
             return False
-        if case['soil_key'] == 'ci':
+        if case['soil_key'] == names.CONE_INDEX:
             if not _same(old.get('requested_cone_index_psi'), case['soil']):
                 return False
         elif 'requested_cone_index_psi' in old or not _same(old.get('cohesion_factor'), case['soil']):
@@ -221,7 +223,7 @@ def reference_ci(soil_key, value, results):
         ci = number(r.get('cone_index_psi'))
         if ci is not None:
             return ci, None
-    if soil_key == 'ci':
+    if soil_key == names.CONE_INDEX:
         return value, None
     return None, 'no cone index for f = %g: %s' % (value, next(
         (str(r.get('cone_index_psi')) for r in results if r.get('cone_index_psi') is not None), 'no result'))
@@ -233,11 +235,14 @@ def soil_summary(soil_key, value, outcomes, nominal_dh=wn.NOMINAL_PNEUMATIC_DH, 
     done = [o for o in outcomes if o.ok and isinstance(o.result, dict)]
     driven = sorted((o for o in done if o.case['drive'] == 'slip'), key=point_slip)
     towed = [o for o in done if o.case['drive'] == 'towed']
-    s = {'soil': soil_label(soil_key, value), soil_key: value}
+    s = {'soil': soil_label(soil_key, value)}
+    if soil_key == names.CONE_INDEX:
+        s['requested_cone_index_psi'] = value
     results = [o.result for o in done]
     ci, why = reference_ci(soil_key, value, results)
     s['cone_index_psi'] = ci
-    s['cohesion_factor'] = _r(results[0].get('cohesion_factor')) if results else None
+    s['cohesion_factor'] = (_r(results[0].get('cohesion_factor')) if results else
+                            value if soil_key == names.COHESION_FACTOR else None)
     geometry = next(((number(r.get('tire_radius')), number(r.get('tire_width')), number(r.get('load')))
                      for r in results), (None, None, None))
     s['tire_radius'], s['tire_width'], s['load'] = (_r(v, 6) for v in geometry)
@@ -300,7 +305,7 @@ def _towed_row(o, refs):
 
 
 def soils_of(a):
-    return ('ci', a.ci) if a.ci else ('f', a.f)
+    return (names.CONE_INDEX, a.ci) if a.ci else (names.COHESION_FACTOR, a.f)
 
 
 def summarise(outcomes, soil_key, soils, opts):
@@ -325,7 +330,7 @@ def summarise(outcomes, soil_key, soils, opts):
                 '(VTI eq. 7, Brixius MR/W at s = 0, Wismer-Luth TF/W)',
         'torque': GT_TEXT,
         'wes': WES_TEXT,
-        'cone_index': 'CI = RCI (the DEM soil does not remold, RI = 1); b, d, W from the results '
+        'cone_index_psi': 'CI = RCI (the DEM soil does not remold, RI = 1); b, d, W from the results '
                       '(tire_width, 2 tire_radius, load)',
         'slip': 'the measured slip of each run (the commanded one where none was measured)',
         'difference': 'sim - VTI (rigid): dp_over_w_minus_vti, torque_over_wr_minus_vti_gt',
@@ -357,7 +362,7 @@ def main(argv=None):
     ap.add_argument('--slip', type=floats, default=floats('0.05,0.1,0.2,0.3,0.5'), help='commanded slips')
     soil = ap.add_mutually_exclusive_group()
     soil.add_argument('--ci', type=floats, help='cone indices [psi] (through the calibration table; default 100)')
-    soil.add_argument('--f', type=floats, help='cohesion factors instead of cone indices')
+    soil.add_argument('--f', type=floats, help='cohesion factors f (dimensionless) instead of cone indices')
     ap.add_argument('--towed', action='store_true', help='also a towed run per soil')
     ap.add_argument('--mu', type=float, help="inter-particle friction (default: the scene's)")
     ap.add_argument('--load', type=float, help="wheel load [kg] (default: the scene's)")
@@ -431,11 +436,14 @@ def main(argv=None):
     except ValueError as e:
         sys.exit('%s: %s' % (PROG, e))
     if a.resume:
-        sweep.resume(accept=same_run(a))
+        try:
+            sweep.resume(accept=same_run(a))
+        except names.OldNameError as e:
+            sys.exit('%s: --resume: %s' % (PROG, e))
     t0 = time.time()
     todo = sum(1 for o in sweep.outcomes if not o.done)
     print('sweep: %d runs (%s %s x slip %s%s), level %s, %d to run, %d at a time' % (
-        len(cases), soil_key, ','.join('%g' % v for v in soils), ','.join('%g' % s for s in a.slip),
+        len(cases), LABEL_PREFIX[soil_key], ','.join('%g' % v for v in soils), ','.join('%g' % s for s in a.slip),
         ' + towed' if a.towed else '', a.fidelity, todo, a.jobs), flush=True)
     interrupted = False
     try:
