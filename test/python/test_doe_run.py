@@ -18,7 +18,7 @@ import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from dem_mobility_tools import paths
-from dem_mobility_tools.doe import cli, plan, runner, slurm
+from dem_mobility_tools.doe import plan, runner, slurm, table
 from dem_mobility_tools.doe.local_cluster import LocalCluster
 
 DOE = [sys.executable, '-m', 'dem_mobility_tools.doe']  # dm-doe
@@ -313,7 +313,7 @@ class RoadDoe(unittest.TestCase):
         for f in ('doe_table.csv', 'doe_speed_vs_ci.png', 'doe_speed_vs_grade.png'):
             self.assertGreater(os.path.getsize(os.path.join(out, f)), 100, f)
         # the table is one `doe map` reads
-        self.assertEqual(cli.read_table(os.path.join(out, 'doe_table.yaml'))['speed'].shape, (3, 1))
+        self.assertEqual(table.read_table(os.path.join(out, 'doe_table.yaml'))['speed'].shape, (3, 1))
         rc, so, _ = doe('status', '--out', out)
         self.assertEqual(rc, 0)
         self.assertIn('simulated 2, implied 1 (runs saved), failed 0, running 0, pending 0', so)

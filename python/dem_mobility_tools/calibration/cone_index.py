@@ -273,7 +273,8 @@ def plots(runs, out, mus, fits):
     return written
 
 
-def main(argv=None):
+def parser():
+    """dm-calibrate's command line."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--scene', default=os.path.join(CONFIG, 'scenes', 'cone_penetrometer.yaml'))
     ap.add_argument('--fidelity', default='coarse', help='level of the scene file (default coarse)')
@@ -299,7 +300,12 @@ def main(argv=None):
     ap.add_argument('--resume', action='store_true',
                     help='keep the runs already in OUT that succeeded with the same level, f, mu and seed (rerun the rest)')
     ap.add_argument('--out', default='results/calibration')
-    a = ap.parse_args(argv)
+    return ap
+
+
+def check_args(a):
+    """Exits naming the option if the command line asks for no table or a bad one; the finest
+    level's runs (--finest), or None."""
     if a.jobs < 1 or a.dem_threads < 1:
         sys.exit('dm-calibrate: --jobs and --dem-threads must be >= 1')
     if not a.seeds or len(set(a.seeds)) != len(a.seeds) or min(a.seeds) < 0:
@@ -322,18 +328,11 @@ def main(argv=None):
             sys.exit('dm-calibrate: --finest %s: %s' % (a.finest, e.strerror))
         except (ValueError, yaml.YAMLError) as e:
             sys.exit('dm-calibrate: --finest: %s' % e)
-    # the commit and the files' hashes as the runs start (a checkout changed during the sweep
-    # does not change what ran)
-    root = ROOT
-    commit = git_commit(root)
-    try:
-        soil_file, diameter, conditions = scene_level(a.scene, a.fidelity)
-        soil_sha, scene_sha = sha256(soil_file), sha256(a.scene)
-    except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as e:
-        sys.exit('dm-calibrate: %s' % e)
-    _, why = ros_package()
-    if why:
-        sys.exit('dm-calibrate: %s: source the catkin workspace (devel/setup.bash) that built it first' % why)
+    return finest_ref
+
+
+def make_sweep(a, conditions, scene_sha, soil_sha):
+    """The sweep's cases and its Sweep (the runs kept by --resume taken in)."""
     os.makedirs(os.path.join(a.out, 'runs'), exist_ok=True)
     try:
         at = dict(a.seeds_at)
@@ -374,6 +373,103 @@ def main(argv=None):
                            describe=describe, poll=1.0, status_every=20.0)
     if a.resume:
         sweep.resume(accept=same_run)
+    return cases, sweep
+
+
+def write_table(a, mu, runs, finest_ref, diameter, prov):
+    """The table of friction `mu` from the finished runs: fitted, written into OUT (and installed
+    with --install), printed; its fit (cubic, table, band, method), or None with fewer than two f
+    values run well. prov: (commit, soil file, its sha256, the scene's sha256, the level's
+    conditions, the checkout)."""
+    commit, soil_file, soil_sha, scene_sha, conditions, root = prov
+    done = sorted(((r.f, r.ci(), r.seed) for r in runs if r.mu == mu and r.ok()))
+    points = mean_points([(f, ci) for f, ci, _ in done])
+    if len(points) < 2:
+        print('mu %g: successful runs at %d f value(s): no fit' % (mu, len(points)))
+        return None
+    made = fit([(f, m) for f, m, _, _ in points], a.table_ci)
+    cubic, table, band, method = made
+    # the scatter of every run about the table (seeds included), relative in CI
+    res = [(ci - interp(f, [t[1] for t in table], [t[0] for t in table])) / ci
+           for f, ci, _ in done if table[0][1] <= f <= table[-1][1]]
+    band = math.sqrt(sum(r * r for r in res) / len(res)) if res else 0.0
+    pts = {'f': [f for f, _, _, _ in points], 'ci_mean': [round(m, 3) for _, m, _, _ in points]}
+    if any(n > 1 for _, _, _, n in points):
+        pts['ci_std'] = [round(sd, 3) if sd is not None else 0.0 for _, _, sd, _ in points]
+    pts['seeds'] = [n for _, _, _, n in points]
+    err = error_vs_finest(a.finest, finest_ref, table, a.fidelity, mu, diameter)
+    doc = {
+        'particle_diameter': diameter,
+        'friction': mu,
+        'fidelity': a.fidelity,
+        'method': method + '; fitted to the mean CI over the seeds at each f',
+        'cubic': cubic,
+        'band': round(band, 4),
+        'table': [[round(c, 2), round(v, 4)] for c, v in table],
+        'points': pts,
+        'runs': {'f': [f for f, _, _ in done], 'seed': [sd for _, _, sd in done],
+                 'ci': [round(ci, 3) for _, ci, _ in done]},
+        'provenance': {
+            'commit': commit,
+            'seeds': sorted(set(sd for _, _, sd in done)),
+            'soil_file': os.path.relpath(soil_file, root),
+            'soil_sha256': soil_sha,
+            'scene_file': os.path.relpath(os.path.abspath(a.scene), root),
+            'scene_sha256': scene_sha,
+            'date': time.strftime('%Y-%m-%d'),
+            'conditions': conditions,
+        },
+        'error_vs_finest': err,
+    }
+    if a.note:
+        doc['provenance']['note'] = a.note
+    path = os.path.join(a.out, 'cone_index_mu%g_d%g.yaml' % (mu, diameter))
+    with open(path, 'w') as fh:
+        fh.write('# Cone index calibration: CI [psi] -> cohesion factor f at mu = %g for particles of %g m\n'
+                 '# (level %s), written by dm-calibrate.\n'
+                 '# cubic: f = c0 CI^3 + c1 CI^2 + c2 CI + c3, fitted to the mean CI per f; table: [CI, f]\n'
+                 '# rows; band: relative rms CI scatter of every run about the table; points: per f, the\n'
+                 '# mean CI over the seeds, its sample std and the number of seeds; runs: every run (f,\n'
+                 '# seed, CI); provenance: where it came from; error_vs_finest: the level\'s CI error against\n'
+                 '# the finest level run.\n' % (mu, diameter, a.fidelity))
+        yaml.safe_dump(doc, fh, default_flow_style=None, sort_keys=False, width=110)
+    print('mu %g: %s; band %.1f %%; table -> %s' % (mu, method, 100 * band, path))
+    print('   f        CI mean [psi]  std over seeds  seeds')
+    for f, m, sd, n in points:
+        print('   %-8g %8.1f      %s      %d' % (f, m, '%8.2f' % sd if sd is not None else '       -', n))
+    print('   CI [psi]   f (ours)   f (paper, mu 0.1)')
+    paper = dict(PAPER_TABLE)
+    for c, v in table:
+        print('   %7.1f   %8.3f   %s' % (c, v, '%.2f' % paper[c] if c in paper else '-'))
+    if a.install:
+        if os.path.isdir(a.install):
+            dest = os.path.join(a.install, os.path.basename(path))
+        elif abs(mu - 0.1) < 1e-12:
+            dest = a.install
+            os.makedirs(os.path.dirname(os.path.abspath(dest)), exist_ok=True)
+        else:
+            return made
+        shutil.copyfile(path, dest)
+        print('   installed as %s' % dest)
+    return made
+
+
+def main(argv=None):
+    a = parser().parse_args(argv)
+    finest_ref = check_args(a)
+    # the commit and the files' hashes as the runs start (a checkout changed during the sweep
+    # does not change what ran)
+    root = ROOT
+    commit = git_commit(root)
+    try:
+        soil_file, diameter, conditions = scene_level(a.scene, a.fidelity)
+        soil_sha, scene_sha = sha256(soil_file), sha256(a.scene)
+    except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as e:
+        sys.exit('dm-calibrate: %s' % e)
+    _, why = ros_package()
+    if why:
+        sys.exit('dm-calibrate: %s: source the catkin workspace (devel/setup.bash) that built it first' % why)
+    cases, sweep = make_sweep(a, conditions, scene_sha, soil_sha)
     t0 = time.time()
     print('sweep: %d runs (f %s x mu %s x seeds %s), level %s, %d at a time' %
           (len(cases), ','.join('%g' % f for f in a.f), ','.join('%g' % m for m in a.mu),
@@ -387,75 +483,10 @@ def main(argv=None):
     runs = [Run(o, a.out) for o in sweep.outcomes]
     fits = {}
     for mu in a.mu:
-        done = sorted(((r.f, r.ci(), r.seed) for r in runs if r.mu == mu and r.ok()))
-        points = mean_points([(f, ci) for f, ci, _ in done])
-        if len(points) < 2:
-            print('mu %g: successful runs at %d f value(s): no fit' % (mu, len(points)))
-            continue
-        fits[mu] = fit([(f, m) for f, m, _, _ in points], a.table_ci)
-        cubic, table, band, method = fits[mu]
-        # the scatter of every run about the table (seeds included), relative in CI
-        res = [(ci - interp(f, [t[1] for t in table], [t[0] for t in table])) / ci
-               for f, ci, _ in done if table[0][1] <= f <= table[-1][1]]
-        band = math.sqrt(sum(r * r for r in res) / len(res)) if res else 0.0
-        pts = {'f': [f for f, _, _, _ in points], 'ci_mean': [round(m, 3) for _, m, _, _ in points]}
-        if any(n > 1 for _, _, _, n in points):
-            pts['ci_std'] = [round(sd, 3) if sd is not None else 0.0 for _, _, sd, _ in points]
-        pts['seeds'] = [n for _, _, _, n in points]
-        err = error_vs_finest(a.finest, finest_ref, table, a.fidelity, mu, diameter)
-        doc = {
-            'particle_diameter': diameter,
-            'friction': mu,
-            'fidelity': a.fidelity,
-            'method': method + '; fitted to the mean CI over the seeds at each f',
-            'cubic': cubic,
-            'band': round(band, 4),
-            'table': [[round(c, 2), round(v, 4)] for c, v in table],
-            'points': pts,
-            'runs': {'f': [f for f, _, _ in done], 'seed': [sd for _, _, sd in done],
-                     'ci': [round(ci, 3) for _, ci, _ in done]},
-            'provenance': {
-                'commit': commit,
-                'seeds': sorted(set(sd for _, _, sd in done)),
-                'soil_file': os.path.relpath(soil_file, root),
-                'soil_sha256': soil_sha,
-                'scene_file': os.path.relpath(os.path.abspath(a.scene), root),
-                'scene_sha256': scene_sha,
-                'date': time.strftime('%Y-%m-%d'),
-                'conditions': conditions,
-            },
-            'error_vs_finest': err,
-        }
-        if a.note:
-            doc['provenance']['note'] = a.note
-        path = os.path.join(a.out, 'cone_index_mu%g_d%g.yaml' % (mu, diameter))
-        with open(path, 'w') as fh:
-            fh.write('# Cone index calibration: CI [psi] -> cohesion factor f at mu = %g for particles of %g m\n'
-                     '# (level %s), written by dm-calibrate.\n'
-                     '# cubic: f = c0 CI^3 + c1 CI^2 + c2 CI + c3, fitted to the mean CI per f; table: [CI, f]\n'
-                     '# rows; band: relative rms CI scatter of every run about the table; points: per f, the\n'
-                     '# mean CI over the seeds, its sample std and the number of seeds; runs: every run (f,\n'
-                     '# seed, CI); provenance: where it came from; error_vs_finest: the level\'s CI error against\n'
-                     '# the finest level run.\n' % (mu, diameter, a.fidelity))
-            yaml.safe_dump(doc, fh, default_flow_style=None, sort_keys=False, width=110)
-        print('mu %g: %s; band %.1f %%; table -> %s' % (mu, method, 100 * band, path))
-        print('   f        CI mean [psi]  std over seeds  seeds')
-        for f, m, sd, n in points:
-            print('   %-8g %8.1f      %s      %d' % (f, m, '%8.2f' % sd if sd is not None else '       -', n))
-        print('   CI [psi]   f (ours)   f (paper, mu 0.1)')
-        paper = dict(PAPER_TABLE)
-        for c, v in table:
-            print('   %7.1f   %8.3f   %s' % (c, v, '%.2f' % paper[c] if c in paper else '-'))
-        if a.install:
-            if os.path.isdir(a.install):
-                dest = os.path.join(a.install, os.path.basename(path))
-            elif abs(mu - 0.1) < 1e-12:
-                dest = a.install
-                os.makedirs(os.path.dirname(os.path.abspath(dest)), exist_ok=True)
-            else:
-                continue
-            shutil.copyfile(path, dest)
-            print('   installed as %s' % dest)
+        made = write_table(a, mu, runs, finest_ref, diameter,
+                           (commit, soil_file, soil_sha, scene_sha, conditions, root))
+        if made is not None:
+            fits[mu] = made
     for p in plots(runs, a.out, a.mu, fits):
         print('plot: %s' % p)
     failed = [r for r in runs if not r.ok()]

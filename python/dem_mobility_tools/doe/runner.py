@@ -359,15 +359,10 @@ def wait_pid(pid, timeout):
         time.sleep(0.02)
 
 
-def run_case(out, index, port=None, dm_run_scene=None, stream=None):
-    """`doe case`: the case's turn. Exit status 0 if it is done (simulated now or before, or
-    implied), 1 if its run failed."""
-    stream = stream or sys.stdout
-    doc = load_plan(out)
-    if not 0 <= index < len(doc['cases']):
-        raise RunnerError('--index %d: the DOE in %s has cases 0-%d' % (index, out, len(doc['cases']) - 1))
-    case = doc['cases'][index]
-    os.makedirs(runs_dir(out), exist_ok=True)
+def claim(out, doc, case, stream):
+    """The case's turn, under the lock: 0 if it needs no run (done before, or its outcome fixed by
+    the finished cases: recorded implied now), else None with its `running` marker written."""
+    index = case['index']
     with locked(out):
         states = scan(out, doc)
         state = states[index][0]
@@ -393,6 +388,20 @@ def run_case(out, index, port=None, dm_run_scene=None, stream=None):
                 os.remove(p)
         write_yaml(marker_path(out, case), {'host': socket.gethostname(), 'pid': os.getpid(), 'start': utc_now(),
                                             'slurm_job': os.environ.get('SLURM_JOB_ID')})
+    return None
+
+
+def run_case(out, index, port=None, dm_run_scene=None, stream=None):
+    """`doe case`: the case's turn. Exit status 0 if it is done (simulated now or before, or
+    implied), 1 if its run failed."""
+    stream = stream or sys.stdout
+    doc = load_plan(out)
+    if not 0 <= index < len(doc['cases']):
+        raise RunnerError('--index %d: the DOE in %s has cases 0-%d' % (index, out, len(doc['cases']) - 1))
+    case = doc['cases'][index]
+    os.makedirs(runs_dir(out), exist_ok=True)
+    if claim(out, doc, case, stream) == 0:
+        return 0
     if port is None:  # (a port given is the pool's slot's or the array task's own: taken as it is)
         port = free_port(port_from_env())  # (its master and the next port: 2 apart, as the pool's)
     argv = case_command(doc, case, out, port, dm_run_scene)

@@ -354,7 +354,8 @@ def write_summary(path, doc):
 
 # -- main
 
-def main(argv=None):
+def parser():
+    """dm-wheel-sweep's command line."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('--scene', default=os.path.join(ROOT, 'config', 'scenes', 'single_wheel.yaml'))
@@ -385,6 +386,11 @@ def main(argv=None):
                     help='--runner core: ' + paths.RUNNER_HELP)
     ap.add_argument('--progress', choices=('auto', 'tqdm', 'plain'), default='auto')
     ap.add_argument('--out', default='results/single_wheel')
+    return ap
+
+
+def main(argv=None):
+    ap = parser()
     a = ap.parse_args(argv)
     for opt, v in (('--ci', a.ci), ('--f', a.f)):
         if v is not None and not v:
