@@ -143,9 +143,16 @@ class LocalCluster:
         self.stop()
 
 
-if __name__ == '__main__':
-    import sys
-    c = LocalCluster(sys.argv[1] if len(sys.argv) > 1 else None).start()
+def main(argv=None):
+    """python3 -m dem_mobility_tools.doe.local_cluster [FOLDER]: a single-node Slurm cluster in
+    FOLDER (default: a temporary one) until Ctrl-C."""
+    import argparse
+    p = argparse.ArgumentParser(prog='python3 -m dem_mobility_tools.doe.local_cluster',
+                                description='A single-node Slurm test cluster (slurmctld, slurmd, munged) '
+                                            'on this machine until Ctrl-C.')
+    p.add_argument('folder', nargs='?', help='its state and configuration (default: a temporary folder)')
+    a = p.parse_args(argv)
+    c = LocalCluster(a.folder).start()
     print('cluster up: export SLURM_CONF=%s' % c.env['SLURM_CONF'], flush=True)
     try:
         signal.pause()
@@ -153,3 +160,7 @@ if __name__ == '__main__':
         pass
     finally:
         c.stop()
+
+
+if __name__ == '__main__':
+    main()
