@@ -16,9 +16,11 @@ source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_MAP_PACKAGES[@]}" "${DM_SLURM_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}" "${DM_SANITIZE_PACKAGES[@]}"
 build_core
 # The soils the tests prepare are prepared once for the whole run and read back by every other
-# test that asks for the same soil (DM_SOIL_CACHE, terrain/dem_soil.h: bit for bit the state the
-# preparation gives); a folder of this run's own, emptied first, so that every run prepares afresh.
-# The tests of the preparation itself (stopped while it runs) unset it.
+# test that asks for the same soil (a folder of prepared soils, terrain/prepared_soil_cache.h: bit
+# for bit the state the preparation gives). dm_run_scene, the terrain nodelet's launch file and
+# the soil tests take the folder from DM_SOIL_CACHE (the core reads no environment); a folder of
+# this run's own, emptied first, so that every run prepares afresh. The tests of the preparation
+# itself (stopped while it runs) unset it.
 export DM_SOIL_CACHE="$DM_BUILD/soil_cache"
 rm -rf "$DM_SOIL_CACHE"
 # The stages below run side by side on the machine's cores, more threads than cores: OpenMP threads

@@ -24,7 +24,7 @@
 #include "dem_mobility/TerrainReport.h"
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
-#include "dem_mobility/core/mobility/vehicle_cosim.h"
+#include "dem_mobility/core/mobility/mobility_params.h"
 #include "dem_mobility/core/dem/dem_system.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
@@ -339,6 +339,7 @@ class TerrainNodelet : public nodelet::Nodelet {
 
   std::mutex mutex_;  ///< the model: the exchange (whatever thread runs it) and the report
   std::unique_ptr<TerrainModel> model_;
+  TerrainDescription description_;  ///< what the terrain is, once it has read its file (the report's)
   std::string error_;
   std::unique_ptr<ExchangeResponder<WheelStates, WheelWrenches>> responder_;
   std::string report_name_;  ///< the report service's name (its entry on TerrainFiguresBoard)
@@ -349,7 +350,6 @@ class TerrainNodelet : public nodelet::Nodelet {
   ros::ServiceServer report_;
   std::string frame_id_ = "odom", exchange_name_;
   std::string prepared_soil_cache_;  ///< ~prepared_soil_cache: the folder of prepared soils ("" none)
-  TerrainDescription description_;   ///< what the terrain is, once it has read its file
   double cloud_rate_ = 10.0, next_frame_ = 0.0, time_ = 0.0, surface_z_ = 0.0;
   std::vector<float> first_shown_;  ///< each particle's plastic strain when first shown (by ID)
   std::vector<WheelState> states_;

@@ -268,8 +268,9 @@ std::string YamlReader::ResolvePath(const std::string& relative) const {
 }
 
 namespace {
-/// Names a thing had before it got its one name (a launch argument or key given the old way is
-/// refused, the message naming the new one).
+/// Names a thing had before it got its one name: a file's own key (a scene's, a terrain's; what
+/// a launch argument or a command-line override sets) given the old way is refused, the message
+/// naming the new one.
 const std::pair<const char*, const char*> kRenamed[] = {
     {"f", "cohesion_factor"}, {"mu", "friction"}, {"grade", "grade_deg"}, {"ci", "cone_index"},
     {"ci_psi", "cone_index"}, {"requested_ci", "cone_index"}, {"cone_index_psi", "cone_index"}};
@@ -282,8 +283,9 @@ void YamlReader::Finish() const {
     const std::string k = KeyText(kv.first);
     if (used_->count(k)) continue;
     unknown += (unknown.empty() ? "" : ", ") + k;
-    for (const auto& [old_name, name] : kRenamed)
-      if (k == old_name) unknown += std::string(" (now ") + name + ")";
+    if (path_.empty())  // (a file's own keys: a nested map's may mean another thing by the name)
+      for (const auto& [old_name, name] : kRenamed)
+        if (k == old_name) unknown += std::string(" (now ") + name + ")";
   }
   if (!unknown.empty()) Fail("", "unknown key(s): " + unknown);
 }

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/dem/dem_energy.h"
 #include "dem_mobility/core/dem/pair_sweep.h"
 

@@ -2,12 +2,10 @@
 
 #include <cmath>
 #include <fstream>
-#include <functional>
 #include <iomanip>
 
 #include "dem_mobility/core/common/error.h"
 #include "dem_mobility/core/common/result_file.h"
-#include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
 
 namespace dem_mobility::core {

@@ -4,9 +4,7 @@
 // the loop that produces them is the co-simulation's (mobility/cosim_loop.h).
 #pragma once
 
-#include <Eigen/Core>
 #include <array>
-#include <limits>
 #include <string>
 #include <utility>
 #include <vector>

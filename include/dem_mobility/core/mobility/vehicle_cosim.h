@@ -7,7 +7,7 @@
 
 #include "dem_mobility/core/common/time_step.h"
 #include "dem_mobility/core/mobility/ports.h"
-#include "dem_mobility/core/mobility/mobility_result.h"
+#include "dem_mobility/core/mobility/mobility_params.h"
 #include "dem_mobility/core/vehicle/vehicle.h"
 #include "dem_mobility/core/vehicle/vehicle_spec.h"
 

@@ -2,7 +2,8 @@
 // for. What a user asks for is a cone index; f is internal to the law. This is the one place where
 // a requested cone index becomes f (through the calibration table of the particles' size and
 // friction: CI(f) depends on both, calibration.h), and where f's limits are checked. The cone
-// penetrometer, the soil bin and the moving patch all read their soil's strength through it.
+// penetrometer and the soil bin (DemSoilParams: the single-wheel rig and the dem_soil terrain with
+// its moving patch) read their soil's strength through it.
 #pragma once
 
 #include <limits>

@@ -134,7 +134,9 @@ const std::vector<TerrainKind>& TerrainKinds();
 /// terrain_overrides) for the wheels of `vehicle`. Throws ConfigError naming file and key of bad
 /// input (an unknown `model:` lists the known ones). `hooks` are called while the terrain prepares
 /// (a DEM soil: every step of its pour, lid and settling; PreparationHooks): once `stop` returns
-/// true, the preparation stops within a step and Interrupted says where it was.
+/// true, the preparation stops within a step and Interrupted says where it was. `hooks.described` is
+/// called exactly once: by a model that prepares for long as soon as it has read its file, else
+/// by this function once the model is built.
 std::unique_ptr<TerrainModel> LoadTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
                                                const std::vector<std::string>& overrides = {},
                                                const PreparationHooks& hooks = {});
@@ -144,7 +146,9 @@ void CheckTerrainModel(const std::string& terrain_file, const TerrainVehicle& ve
                        const std::vector<std::string>& overrides = {});
 /// The same for a terrain file already read (the fuzz harness's text).
 void CheckTerrainModel(const YamlReader& terrain_file, const TerrainVehicle& vehicle);
-/// What `terrain_file` describes (model, cone index, time step, level), without building it.
+/// What `terrain_file` describes (model, cone index, time step, level), without building it (a
+/// run learns it from its terrain once, through PreparationHooks::described; this is for a look
+/// at a file, and the tests).
 TerrainDescription DescribeTerrain(const std::string& terrain_file, const std::vector<std::string>& overrides = {});
 /// The terrain of a checkpoint: the model `terrain_file` names, its state read from `in`.
 std::unique_ptr<TerrainModel> RestoreTerrainModel(const std::string& terrain_file, const TerrainVehicle& vehicle,
