@@ -21,7 +21,7 @@ ros_env
 display=":$(( 90 + RANDOM % 9 ))"
 Xvfb "$display" -screen 0 1280x760x24 >/dev/null 2>&1 &
 xvfb=$!
-port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])')
+port=$(PYTHONPATH="$DM_ROOT/python" python3 -c 'from dem_mobility_tools.runs import free_port; print(free_port())')
 tmp="$(mktemp -d)"
 trap 'kill $launch $xvfb 2>/dev/null; rm -rf "$tmp"' EXIT
 bag_arg=(bag:="$tmp/run.bag")  # unless the caller names one (to replay it later)
