@@ -28,8 +28,8 @@
 # exchanging with a tire; the dem_pour scene's test takes 2.5 min of CPU here: --all runs it), the
 # wheel rig (a tiny bin that cannot carry its load: the whole rig run) and the soil patch (its
 # emitter's lattice, its input checks, and a small patch that follows the wheels and re-emits its
-# soil). Some 8 min of CPU in all (4 min on two cores, side by side). A skipped test in any log fails the
-# run (test/check_skips.py).
+# soil). Some 8 min of CPU in all (4 min on two cores, side by side). A skipped test in any log
+# fails the run (test/check_skips.py).
 source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_SANITIZE_PACKAGES[@]}"
 dir="$DM_BUILD/sanitize"
@@ -50,7 +50,7 @@ case "${1:-}" in
     fuzz_seconds="${3:-600}"
     [[ " ${fuzz_targets[*]} " == *" $fuzz_only "* ]] || { echo "sanitize.sh: no fuzz target '$fuzz_only' (${fuzz_targets[*]})"; exit 2; }
     tests=() soil=() ;;
-  --help|-h) sed -n '2,28p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  --help|-h) sed -n '2,32p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   "") tests=("${quick[@]}") ;;
   *) tests=("$@") soil=() ;;
 esac
