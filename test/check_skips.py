@@ -7,13 +7,14 @@
 
 What counts as a skip, by the log's kind (a log may hold several kinds and several runs):
   - GoogleTest: "[  SKIPPED ] Suite.Test (N ms)" (its message: the lines since "[ RUN      ]"),
-    and "YOU HAVE N DISABLED TESTS";
+    a name in the summary's list of skipped tests, and "YOU HAVE N DISABLED TESTS";
   - ctest: a test "***Skipped" or "***Not Run", and the "(Skipped)"/"(Disabled)"/"(Not Run)"
     lines of its summary;
   - python unittest: "test (module.Class...) ... skipped 'reason'" (the verbose form), and the
     count of "OK (skipped=N)" / "FAILED (..., skipped=N)": skips it counts but does not name (a
     run without -v) are unlisted, since they cannot be matched;
-  - catkin_test_results: "Summary: ..., N skipped" (unnamed: unlisted).
+  - catkin_test_results: a result file's "NAME: ..., N skipped" line, and the skips of its
+    "Summary: ..., N skipped" that no such line names (unnamed: unlisted).
 Every unlisted skip is named with its log; the exit status is then 1. A log that is missing or
 empty is an error (exit 2): nothing was checked.
 """
@@ -32,12 +33,14 @@ DEFAULT_LIST = os.path.join(HERE, 'allowed_skips.yaml')
 
 GTEST_RUN = re.compile(r'^\[ RUN      \] (\S+)')
 GTEST_SKIPPED = re.compile(r'^\[  SKIPPED \] (\S+) \(\d+ ms\)')
+GTEST_SKIPPED_LISTED = re.compile(r'^\[  SKIPPED \] (\S+)\s*$')  # the summary's list (no message)
 GTEST_DISABLED = re.compile(r'YOU HAVE (\d+) DISABLED TESTS?')
 CTEST_SKIPPED = re.compile(r'Test\s+#\d+: (\S+) \.*\s*\*+(Skipped|Not Run)')
 CTEST_SUMMARY = re.compile(r'^\s*\d+ - (\S+) \((Skipped|Disabled|Not Run)\)')
 UNITTEST_HEAD = re.compile(r'^(\w+) \(([\w.]+)\)')
 UNITTEST_SKIPPED = re.compile(r"(?:^|\.\.\. )skipped '(.*)'\s*$")
 UNITTEST_COUNT = re.compile(r'^(?:OK|FAILED) \((?:.*, )?skipped=(\d+)')
+CATKIN_FILE = re.compile(r'^(\S+): \d+ tests?, \d+ errors?, \d+ failures?, (\d+) skipped')
 CATKIN_SUMMARY = re.compile(r'Summary: \d+ tests?, \d+ errors?, \d+ failures?, (\d+) skipped')
 
 
@@ -78,6 +81,7 @@ def skips_in(text):
     found = []
     gtest_current, gtest_lines = None, []
     unittest_head, unittest_named = None, 0
+    catkin_named = 0
     for line in text.splitlines():
         m = GTEST_RUN.match(line)
         if m:
@@ -89,6 +93,10 @@ def skips_in(text):
             found.append((m.group(1), msg if gtest_current == m.group(1) else ''))
             gtest_current = None
             continue
+        m = GTEST_SKIPPED_LISTED.match(line)
+        if m:
+            found.append((m.group(1), ''))  # (one already found with its message is kept as that)
+            continue
         if gtest_current is not None:
             gtest_lines.append(line)
         m = GTEST_DISABLED.search(line)
@@ -99,9 +107,18 @@ def skips_in(text):
         if m:
             found.append(('ctest:' + m.group(1), 'ctest: ' + m.group(2)))
             continue
+        m = CATKIN_FILE.match(line)
+        if m and not line.startswith('Summary:'):
+            if int(m.group(2)) > 0:
+                found.append(('catkin:' + m.group(1), '%s skipped in this result file' % m.group(2)))
+                catkin_named += int(m.group(2))
+            continue
         m = CATKIN_SUMMARY.search(line)
-        if m and int(m.group(1)) > 0:
-            found.append((None, '%s skipped catkin test(s)' % m.group(1)))
+        if m:
+            unnamed = int(m.group(1)) - catkin_named
+            if unnamed > 0:
+                found.append((None, '%d skipped catkin test(s) not named' % unnamed))
+            catkin_named = 0
             continue
         m = UNITTEST_HEAD.match(line)
         if m:
@@ -186,6 +203,9 @@ def self_test():
          'pair kernel vector-avx2: this CPU lacks AVX2, FMA or BMI2\n\n'
          '[  SKIPPED ] PairKernel/VectorInstance.Sweep/avx2 (0 ms)\n[  PASSED  ] 4 tests.\n', set(), 0),
         ('  YOU HAVE 1 DISABLED TEST\n', {None}, 1),
+        # only the summary's list (a brief run): no message, so not the listed skip
+        ('[  SKIPPED ] 1 test, listed below:\n[  SKIPPED ] PairKernel/VectorInstance.Sweep/avx512\n',
+         {'PairKernel/VectorInstance.Sweep/avx512'}, 1),
         ('12/30 Test #12: core.planted ....................***Skipped   0.01 sec\n', {'ctest:core.planted'}, 1),
         ('The following tests did not run:\n\t 14 - core.other (Disabled)\n', {'ctest:core.other'}, 1),
         ('3/9 Test #3: core.gone ........................***Not Run   0.00 sec\n', {'ctest:core.gone'}, 1),
@@ -195,6 +215,8 @@ def self_test():
          "FAILED (failures=1, skipped=1)\n", {'test_doe_run.Slurm.test_run'}, 1),
         ('..s.\n------\nRan 4 tests in 0.1s\n\nOK (skipped=1)\n', {None}, 1),
         ('Summary: 12 tests, 0 errors, 0 failures, 2 skipped\n', {None}, 1),
+        ('rostest-test_road_scene.xml: 3 tests, 0 errors, 0 failures, 1 skipped\n'
+         'Summary: 12 tests, 0 errors, 0 failures, 1 skipped\n', {'catkin:rostest-test_road_scene.xml'}, 1),
         ('Summary: 12 tests, 0 errors, 0 failures, 0 skipped\nOK\n', set(), 0),
     ]
     failures = []
