@@ -10,7 +10,8 @@
 # finding is kept as $DM_BUILD/sanitize/fuzz/<target>-crash-* (copy it into
 # test/fuzz/regressions/<target>/ once fixed: config_test reads those in every build).
 #
-#   ./scripts/sanitize.sh                 what ./scripts/test.sh runs: the quick test programs and
+#   ./scripts/sanitize.sh                 what ./scripts/test.sh runs: the quick test programs, the
+#                                         soil code on small configurations (below) and
 #                                         DM_FUZZ_RUNS (default 2000) inputs per harness
 #   ./scripts/sanitize.sh --all           all the fast test programs (about 10 min of runs)
 #   ./scripts/sanitize.sh TEST...         the test programs named (targets of test/core)
@@ -21,33 +22,52 @@
 # runs some 8 min each: they are left out here (the checkpoint reader's refusals of damaged
 # files run in cosim_test's Checkpoint test). vehicle_test runs some 30 times slower under the sanitizers (its climbs take
 # minutes each): name it to run it.
+# The soil code runs on small configurations (GoogleTest cases of longer programs, each a log of its
+# own, soil_<name>.log): the tire walls (the binned tire contact against the triangle scan, action
+# and reaction), the soil preparation (the tiny bin poured, pressed by the lid and released, then
+# exchanging with a tire; the dem_pour scene's test takes 2.5 min of CPU here: --all runs it), the
+# wheel rig (a tiny bin that cannot carry its load: the whole rig run) and the soil patch (its
+# emitter's lattice, its input checks, and a small patch that follows the wheels and re-emits its
+# soil). Some 8 min of CPU in all (4 min on two cores, side by side). A skipped test in any log
+# fails the run (test/check_skips.py).
 source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_SANITIZE_PACKAGES[@]}"
 dir="$DM_BUILD/sanitize"
 quick=(config_test contact_test joints_test integrator_test soil_law_test pair_kernel_test dem_particles_test
   powertrain_test)
+# NAME=PROGRAM:GTEST_FILTER
+soil=(tire_walls=wheel_test:TireContact.*
+  soil_prep=wheel_test:DemSoilTerrain.AdvancesInWholeSoilStepsAndReturnsTheMeanReaction
+  wheel_rig=wheel_test:SingleWheelRig.ALoadTheSoilCannotCarryIsReportedSunk
+  soil_patch=wheel_test:DemSoilTerrain.ASmallPatchFollowsTheWheelsAndReEmitsKeepingItsCount
+  soil_patch_input=soil_patch_test:SoilPatch.PoursItsPartialTopLayerEvenlyAcrossTheWidth:VehicleOnSoil.RefusesBadInputNamingFileAndKey)
 fuzz_targets=(scene vehicle terrain soil calibration)
 fuzz_only="" fuzz_seconds=600
 case "${1:-}" in
-  --all) tests=("${quick[@]}" dem_pour_test cosim_test dem_test wheel_test) ;;
+  --all) tests=("${quick[@]}" dem_pour_test cosim_test dem_test wheel_test) soil=() ;;
   --fuzz)
     fuzz_only="${2:?usage: sanitize.sh --fuzz TARGET [SECONDS] (targets: ${fuzz_targets[*]})}"
     fuzz_seconds="${3:-600}"
     [[ " ${fuzz_targets[*]} " == *" $fuzz_only "* ]] || { echo "sanitize.sh: no fuzz target '$fuzz_only' (${fuzz_targets[*]})"; exit 2; }
-    tests=() ;;
-  --help|-h) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    tests=() soil=() ;;
+  --help|-h) sed -n '2,32p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   "") tests=("${quick[@]}") ;;
-  *) tests=("$@") ;;
+  *) tests=("$@") soil=() ;;
 esac
+soil_programs=()
+for c in "${soil[@]}"; do
+  p="${c#*=}"; p="${p%%:*}"
+  [[ " ${tests[*]} ${soil_programs[*]} " == *" $p "* ]] || soil_programs+=("$p")
+done
 san="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
-say "build: clang, ASan + UBSan + libFuzzer in $dir (${tests[*]:-} fuzz_*)"
+say "build: clang, ASan + UBSan + libFuzzer in $dir (${tests[*]:-} ${soil_programs[*]:-} fuzz_*)"
 ninja_folder "$dir"
 cmake -G Ninja -S "$DM_ROOT" -B "$dir" -DCMAKE_CXX_COMPILER=clang++ -DDM_BUILD_ROS=OFF -DDM_BUILD_BENCH=OFF -DDM_BUILD_FUZZ=ON \
   -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -gline-tables-only $san -fsanitize=fuzzer-no-link" \
   -DCMAKE_EXE_LINKER_FLAGS_SANITIZE="-fsanitize=address,undefined" >/dev/null
 targets=(fuzz_seeds)
 for t in "${fuzz_targets[@]}"; do targets+=("fuzz_$t"); done
-cmake --build "$dir" -j"$(nproc)" --target "${tests[@]}" "${targets[@]}" dm_run_scene
+cmake --build "$dir" -j"$(nproc)" --target "${tests[@]}" "${soil_programs[@]}" "${targets[@]}" dm_run_scene
 export ASAN_OPTIONS=detect_leaks=1:halt_on_error=1:abort_on_error=0
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 # The test programs and the harnesses run as many at a time as there are cores (each is one
@@ -64,9 +84,17 @@ run_test() {
   [ "$1" = config_test ] && filter=(--gtest_filter=-Config.RunnerInterrupted*:Config.RunnerOnAFullDisk*:Config.RunnerStopped*)
   cd "$dir/test/core" && "./$1" "${filter[@]}" >"$dir/$1.log" 2>&1
 }
+run_soil() {  # run_soil NAME PROGRAM FILTER
+  cd "$dir/test/core" && "./$2" --gtest_filter="$3" >"$dir/soil_$1.log" 2>&1
+}
 for t in "${tests[@]}"; do
   say "sanitize: $t"
   pool "$t" run_test "$t"
+done
+for c in "${soil[@]}"; do
+  name="${c%%=*}" spec="${c#*=}"
+  say "sanitize: soil, $name (${spec%%:*} --gtest_filter=${spec#*:})"
+  pool "soil_$name" run_soil "$name" "${spec%%:*}" "${spec#*:}"
 done
 
 # the fuzzers: the shipped files as seeds, a corpus of their own per run (the quick run starts afresh
@@ -113,6 +141,20 @@ for t in "${tests[@]}"; do
   grep -E "ERROR: AddressSanitizer|runtime error|LeakSanitizer|FAILED" "$dir/$t.log" | head -20 || true
   echo "(log: $dir/$t.log)"
 done
+for c in "${soil[@]}"; do
+  t="soil_${c%%=*}"
+  [ "$(cat "$status/$t")" = 0 ] && { echo "$t: $(grep -E '^\[  PASSED  \]' "$dir/$t.log" || true)"; continue; }
+  failed+=("$t")
+  grep -E "ERROR: AddressSanitizer|runtime error|LeakSanitizer|FAILED" "$dir/$t.log" | head -20 || true
+  echo "(log: $dir/$t.log)"
+done
+# a skipped test is a failure unless test/allowed_skips.yaml lists it
+logs=()
+for t in "${tests[@]}"; do logs+=("$dir/$t.log"); done
+for c in "${soil[@]}"; do logs+=("$dir/soil_${c%%=*}.log"); done
+if [ ${#logs[@]} -gt 0 ] && ! python3 "$DM_ROOT/test/check_skips.py" "${logs[@]}"; then
+  failed+=("skips")
+fi
 for t in "${fuzzed[@]}"; do
   log="$dir/fuzz_$t.log"
   if [ "$(cat "$status/fuzz_$t")" = 0 ]; then
@@ -131,4 +173,4 @@ if [ ${#failed[@]} -gt 0 ]; then
   echo "sanitize: failed: ${failed[*]}"
   exit 1
 fi
-say "sanitize: ${#tests[@]} test program(s) and the fuzz harness(es): no report"
+say "sanitize: ${#tests[@]} test program(s), ${#soil[@]} soil configuration(s) and the fuzz harness(es): no report"

@@ -408,8 +408,10 @@ TEST(VehicleOnSoil, AtRestCarriesItsWeightAndStopsSinking) {
   const double* ws = watch.wheel_sink;
   std::printf("sinkage per wheel (2.1-2.4 s): fl %.4f fr %.4f rl %.4f rr %.4f m\n", ws[0] / watch.n[1],
               ws[1] / watch.n[1], ws[2] / watch.n[1], ws[3] / watch.n[1]);
-  // (the left wheels against the right ones: one wheel's sinkage scatters by a quarter at this
-  // particle size, 0.4 of the tire's width; a bed thicker on one side showed as 50 % and more)
+  // each axle's left and right wheels within a quarter of the mean sinkage of each other, and the
+  // left wheels against the right ones within 15 % (a bed thicker on one side showed as 50 % and more)
+  EXPECT_LT(std::abs(ws[0] - ws[1]) / watch.n[1], 0.25 * s1) << "front left and right";
+  EXPECT_LT(std::abs(ws[2] - ws[3]) / watch.n[1], 0.25 * s1) << "rear left and right";
   const double left = 0.5 * (ws[0] + ws[2]) / watch.n[1], right = 0.5 * (ws[1] + ws[3]) / watch.n[1];
   EXPECT_LT(std::abs(left - right), 0.15 * s1) << "left " << left << " m, right " << right << " m";
   // the sinkage stops growing: the cohesive soil creeps under the standing load, ever slower;

@@ -1,6 +1,6 @@
 // The tire on DEM soil: the tire's soil surface, the binned tire contact against the brute-force
-// triangle scan, action and reaction, the dem_soil terrain's exchange, the single-wheel rig's input
-// checks. (The rig's physics runs for minutes: wheel_rig_test.cpp.)
+// triangle scan, action and reaction, the dem_soil terrain's exchange, a small moving soil patch,
+// the single-wheel rig's input checks. (The rig's physics runs for minutes: wheel_rig_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -15,6 +15,8 @@
 #include "dem_mobility/core/geometry/tire_geometry.h"
 #include "dem_mobility/core/scenes/single_wheel.h"
 #include "dem_mobility/core/terrain/dem_soil.h"
+#include "dem_mobility/core/terrain/soil_patch.h"
+#include "dem_mobility/core/vehicle/vehicle_spec.h"
 #include "dem_test_soils.h"
 
 namespace dem_mobility::core {
@@ -248,6 +250,51 @@ TEST(DemSoilTerrain, AdvancesInWholeSoilStepsAndReturnsTheMeanReaction) {
   EXPECT_GT(wr[0].stiffness, 0.0);
   EXPECT_THROW(model->Advance(2.5 * h), SimulationError);  // not a whole number of soil steps
   EXPECT_THROW(model->Synchronize(401, 1.0, {s, s}), std::exception);
+}
+
+// A small moving soil patch, small enough for the sanitizer build (scripts/sanitize.sh; the patch's
+// own tests, soil_patch_test, take minutes even at full speed): the tiny level in its shortest box
+// (6 m), soil only in the narrowest strips under the wheel tracks (0.46 m: a tire and two particle
+// diameters), settled for 0.05 s and released from the lid in 0.1 s. Four wheels ride
+// 0.5 m above the soil at 8 m/s for 1.5 m beyond where the patch starts to follow them: it follows,
+// removes the soil its sphere leaves behind and lays it down again ahead, and the particle count
+// never changes.
+TEST(DemSoilTerrain, ASmallPatchFollowsTheWheelsAndReEmitsKeepingItsCount) {
+  const VehicleSpec spec = VehicleSpec::Load(DM_CONFIG_DIR "/vehicles/hmmwv/vehicle.yaml");
+  std::unique_ptr<TerrainModel> m =
+      LoadTerrainModel(DM_CONFIG_DIR "/terrains/soil_patch.yaml", TerrainVehicleOf(spec),
+                       {"fidelity=tiny", "threads=1", "cone_index=100", "track_strip_width=0.46", "levels.tiny.length=6",
+                        "levels.tiny.settle_time=0.05", "lid.release_time=0.1", "patch.check_window=[0.3, 0.7]"});
+  auto* t = dynamic_cast<DemSoilTerrain*>(m.get());
+  ASSERT_NE(t, nullptr);
+  ASSERT_NE(t->patch(), nullptr);
+  const SoilPatch& patch = *t->patch();
+  const int n0 = t->bin().dem().num_alive();
+  const double h = t->description().time_step, r = t->bin().tire().radius, v = 8.0;
+  const double x_end = patch.sphere_centre().x() + 1.5;
+  const double xs[4] = {1.65, 1.65, -1.65, -1.65}, ys[4] = {0.9, -0.9, 0.9, -0.9};
+  std::vector<WheelState> wheels(4);
+  std::vector<WheelWrench> w;
+  double x = 0.0;
+  for (long k = 0; x < x_end; ++k) {
+    for (int i = 0; i < 4; ++i) {
+      wheels[i].position = Vector3d(x + xs[i], ys[i], 1.0);
+      wheels[i].velocity = Vector3d(v, 0.0, 0.0);
+      wheels[i].angular_velocity = Vector3d(0.0, v / r, 0.0);
+    }
+    t->Synchronize(k, k * h, wheels);
+    t->GetWrenches(&w);
+    t->Advance(h);
+    ASSERT_EQ(t->bin().dem().num_alive(), n0) << "step " << k;
+    x += v * h;
+  }
+  const PatchStats& s = patch.stats();
+  EXPECT_TRUE(s.following);
+  // the sphere moved 1.5 m: the soil of about 1.5 m of the two strips (some 500 particles) left it
+  EXPECT_GT(s.reemitted, 300);
+  EXPECT_GT(s.copies, 0);
+  EXPECT_NEAR(patch.sphere_centre().x(), x, 1e-9);  // it follows the wheels' centroid
+  std::printf("%d particles; re-emitted %ld (strays %ld), copies %d\n", n0, s.reemitted, s.strays, s.copies);
 }
 
 std::string SceneFile() { return DM_CONFIG_DIR "/scenes/single_wheel.yaml"; }
