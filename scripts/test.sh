@@ -10,8 +10,10 @@
 #     the speed-made-good map published as an OccupancyGrid (test/ros/test_map_publisher.py),
 #  4. catkin_lint on the package (must report nothing),
 #  5. the core built with clang under AddressSanitizer and UndefinedBehaviorSanitizer: the quick
-#     core test programs and the libFuzzer harnesses of every configuration loader, their
-#     regression inputs and a fixed number of new inputs each (scripts/sanitize.sh).
+#     core test programs, small configurations of the soil code (tire walls, preparation, wheel
+#     rig, patch) and the libFuzzer harnesses of every configuration loader, their regression
+#     inputs and a fixed number of new inputs each (scripts/sanitize.sh),
+#  6. no test skipped unless test/allowed_skips.yaml lists it with its reason (test/check_skips.py).
 source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_ROS_PACKAGES[@]}" "${DM_MAP_PACKAGES[@]}" "${DM_SLURM_PACKAGES[@]}" "${DM_CHECK_PACKAGES[@]}" "${DM_SANITIZE_PACKAGES[@]}"
 build_core
@@ -23,6 +25,8 @@ build_core
 # itself (stopped while it runs) unset it.
 export DM_SOIL_CACHE="$DM_BUILD/soil_cache"
 rm -rf "$DM_SOIL_CACHE"
+# every test's output is kept for the skip check at the end (test/check_skips.py); this run's only
+rm -f "$DM_BUILD"/test_*.log "$DM_BUILD/catkin_test_results.log"
 # The stages below run side by side on the machine's cores, more threads than cores: OpenMP threads
 # that sleep at a barrier instead of spinning leave the cores to the work (results do not depend on it).
 export OMP_WAIT_POLICY=PASSIVE
@@ -40,26 +44,26 @@ build_catkin
 ros_env
 say "test: catkin tests (roslaunch-check, rostest)"
 (cd "$DM_WS" && catkin_make --use-ninja run_tests -j"$(nproc)" >"$DM_BUILD/run_tests.log" 2>&1) || true
-if ! catkin_test_results --verbose "$DM_WS/build/test_results/dem_mobility"; then
+if ! catkin_test_results --verbose "$DM_WS/build/test_results/dem_mobility" | tee "$DM_BUILD/catkin_test_results.log"; then
   tail -60 "$DM_BUILD/run_tests.log"
   echo "catkin tests failed; full log: $DM_BUILD/run_tests.log"
   exit 1
 fi
 say "test: the Python package dem_mobility_tools (python unit tests, no ROS; one tiny wheel run through the core; installed by pip, its console scripts)"
 (cd "$DM_ROOT" && PYTHONPATH="$DM_ROOT/python${PYTHONPATH:+:$PYTHONPATH}" DM_RUN_SCENE="$DM_BUILD/core/src/tools/dm_run_scene" \
-  python3 -m unittest discover -s test/python -v)
+  python3 -m unittest discover -s test/python -v) 2>&1 | tee "$DM_BUILD/test_python.log"
 say "test: the bag recorder on its own (a latched message delivered twice is recorded once)"
-python3 "$DM_ROOT/test/ros/test_bag_recorder.py"
+python3 "$DM_ROOT/test/ros/test_bag_recorder.py" 2>&1 | tee "$DM_BUILD/test_ros_test_bag_recorder.log"
 say "test: end-to-end road runs through roslaunch"
-DM_RUN_SCENE="$DM_BUILD/core/src/tools/dm_run_scene" python3 "$DM_ROOT/test/ros/test_road_runs.py"
+DM_RUN_SCENE="$DM_BUILD/core/src/tools/dm_run_scene" python3 "$DM_ROOT/test/ros/test_road_runs.py" 2>&1 | tee "$DM_BUILD/test_ros_test_road_runs.log"
 say "test: the cone index calibration sweep on tiny cases (roslaunch, bags, table, plots)"
-python3 "$DM_ROOT/test/ros/test_cone_sweep.py"
+python3 "$DM_ROOT/test/ros/test_cone_sweep.py" 2>&1 | tee "$DM_BUILD/test_ros_test_cone_sweep.log"
 say "test: the single-wheel rig through roslaunch (tiny run: bag, result message and YAML; a bad slip)"
-python3 "$DM_ROOT/test/ros/test_single_wheel.py"
+python3 "$DM_ROOT/test/ros/test_single_wheel.py" 2>&1 | tee "$DM_BUILD/test_ros_test_single_wheel.log"
 say "test: the vehicle on the DEM soil patch through roslaunch (tiny: result and soil figures as the core runner's, bag, 1 vs 2 soil threads; a bad cone index; Ctrl-C in the preparation and while driving)"
-DM_RUN_SCENE="$DM_BUILD/core/src/tools/dm_run_scene" python3 "$DM_ROOT/test/ros/test_soil_slope.py"
+DM_RUN_SCENE="$DM_BUILD/core/src/tools/dm_run_scene" python3 "$DM_ROOT/test/ros/test_soil_slope.py" 2>&1 | tee "$DM_BUILD/test_ros_test_soil_slope.log"
 say "test: the speed-made-good map on ROS (mobility_map.launch: nav_msgs/OccupancyGrid as map_server reads the file)"
-python3 "$DM_ROOT/test/ros/test_map_publisher.py"
+python3 "$DM_ROOT/test/ros/test_map_publisher.py" 2>&1 | tee "$DM_BUILD/test_ros_test_map_publisher.log"
 say "test: catkin_lint"
 lint=$(cd "$DM_WS/src" && catkin_lint dem_mobility 2>&1 | grep -v rosdep)
 echo "$lint"
@@ -71,4 +75,9 @@ wait "$ctest_pid" || true
 trap - EXIT
 cat "$DM_BUILD/ctest.log"
 [ "$(cat "$DM_BUILD/ctest.rc" 2>/dev/null)" = 0 ] || { echo "core suite failed (log: $DM_BUILD/ctest.log)"; exit 1; }
+say "test: skipped tests (only those test/allowed_skips.yaml lists, with their reason, may be)"
+# ctest's log names skipped and not-run entries; LastTest.log holds every test program's own output
+# (GoogleTest's [  SKIPPED ] lines); the sanitizer runs are checked by scripts/sanitize.sh itself
+python3 "$DM_ROOT/test/check_skips.py" "$DM_BUILD/ctest.log" "$DM_BUILD/core/Testing/Temporary/LastTest.log" \
+  "$DM_BUILD/catkin_test_results.log" "$DM_BUILD/test_python.log" "$DM_BUILD"/test_ros_*.log
 say "test: all passed"
