@@ -30,7 +30,7 @@ args=(bag:="$bag")
 [ "$scene" = soil_slope ] && args+=(fidelity:="$SOIL_FIDELITY")
 say "run: roslaunch dem_mobility $scene.launch ${args[*]} $* (the soil is prepared first: minutes at coarse)"
 # a master of its own, on a free port, so that a running roscore is left alone
-port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])')
+port=$(PYTHONPATH="$DM_ROOT/python" python3 -c 'from dem_mobility_tools.runs import free_port; print(free_port())')
 ROS_MASTER_URI="http://localhost:$port" roslaunch -p "$port" dem_mobility "$scene.launch" "${args[@]}" "$@"
 [ -f "$result" ] || { echo "run.sh: the run wrote no result ($result)" >&2; exit 1; }
 say "result: $result"
