@@ -8,6 +8,7 @@ import numpy as np
 import yaml
 
 from ..names import OldNameError, refuse_old_keys
+from ..runs import read_result
 from . import maps, plan
 from .design import UsageError
 
@@ -31,13 +32,9 @@ def write_table(path_stem, grid, rows, provenance):
 def read_table(path):
     """A case table (doe run's doe_table.yaml, doe nrmm's nrmm_table.yaml): its grades, cone
     indices and the speed matrix (a row per grade), checked; UsageError naming the file."""
-    try:
-        with open(path) as fh:
-            doc = yaml.safe_load(fh)
-    except OSError as e:
-        raise UsageError('%s: cannot read the table (%s)' % (path, e.strerror))
-    except yaml.YAMLError as e:
-        raise UsageError('%s: not YAML (%s)' % (path, str(e).replace('\n', ' ')))
+    doc, why = read_result(path)
+    if doc is None and 'not YAML' in why:
+        raise UsageError(why)
     for k in ('grades', 'cone_indices', 'speed'):
         if not isinstance(doc, dict) or k not in doc:
             raise UsageError('%s: not a case table (no %s)' % (path, k))

@@ -24,6 +24,7 @@ import os
 import yaml
 
 from . import wheel_numerics
+from ..runs import read_result
 
 LB = 0.45359237           # kg
 INCH = 0.0254             # m
@@ -93,15 +94,9 @@ class Vehicle:
 
     @classmethod
     def load(cls, path):
-        try:
-            with open(path) as fh:
-                d = yaml.safe_load(fh)
-        except OSError as e:
-            raise NrmmError('%s: cannot read (%s)' % (path, e.strerror))
-        except yaml.YAMLError as e:
-            raise NrmmError('%s: not YAML (%s)' % (path, e))
-        if not isinstance(d, dict):
-            raise NrmmError('%s: expected a mapping of keys' % path)
+        d, why = read_result(path)
+        if d is None:
+            raise NrmmError('cannot read the vehicle file: %s' % why)
         return cls(d, path)
 
     # -- go/no-go: mobility index and vehicle cone index ------------------------------------------
