@@ -25,11 +25,11 @@
 # The soil code runs on small configurations (GoogleTest cases of longer programs, each a log of its
 # own, soil_<name>.log): the tire walls (the binned tire contact against the triangle scan, action
 # and reaction), the soil preparation (the tiny bin poured, pressed by the lid and released, then
-# exchanging with a tire; the dem_pour scene's test takes 2.5 min of CPU here: --all runs it), the
-# wheel rig (a tiny bin that cannot carry its load: the whole rig run) and the soil patch (its
-# emitter's lattice, its input checks, and a small patch that follows the wheels and re-emits its
-# soil). Some 8 min of CPU in all (4 min on two cores, side by side). A skipped test in any log
-# fails the run (test/check_skips.py).
+# exchanging with a tire; the dem_pour scene's test takes 2.5 min of CPU here: --all runs it) and
+# the soil patch's emitter and input checks; some 2.5 min of CPU. The whole wheel rig on a tiny bin
+# (2 min of CPU) and a small patch following the wheels (5 min) run with --all, or named:
+#   ./scripts/sanitize.sh wheel_test     (every wheel_test case, those two among them)
+# A skipped test in any log fails the run (test/check_skips.py).
 source "$(dirname "$0")/lib.sh"
 ensure_packages "${DM_CORE_PACKAGES[@]}" "${DM_SANITIZE_PACKAGES[@]}"
 dir="$DM_BUILD/sanitize"
@@ -38,8 +38,6 @@ quick=(config_test contact_test joints_test integrator_test soil_law_test pair_k
 # NAME=PROGRAM:GTEST_FILTER
 soil=(tire_walls=wheel_test:TireContact.*
   soil_prep=wheel_test:DemSoilTerrain.AdvancesInWholeSoilStepsAndReturnsTheMeanReaction
-  wheel_rig=wheel_test:SingleWheelRig.ALoadTheSoilCannotCarryIsReportedSunk
-  soil_patch=wheel_test:DemSoilTerrain.ASmallPatchFollowsTheWheelsAndReEmitsKeepingItsCount
   soil_patch_input=soil_patch_test:SoilPatch.PoursItsPartialTopLayerEvenlyAcrossTheWidth:VehicleOnSoil.RefusesBadInputNamingFileAndKey)
 fuzz_targets=(scene vehicle terrain soil calibration)
 fuzz_only="" fuzz_seconds=600

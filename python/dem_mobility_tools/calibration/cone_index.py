@@ -29,6 +29,7 @@ import time
 import yaml
 
 from .. import sweep as dm_sweep
+from ..sweep import keep as dm_keep
 from ..paths import CONFIG, ROOT
 from ..runs import scene_command
 from ..sweep.args import floats, git_commit, ints, keep_options, ros_package, sha256
@@ -300,6 +301,12 @@ def parser():
     ap.add_argument('--resume', action='store_true',
                     help='keep the runs already in OUT that succeeded with the same level, f, mu and seed (rerun the rest)')
     ap.add_argument('--out', default='results/calibration')
+    ap.add_argument('--keep', metavar='DIR',
+                    help='also write each good run\'s result, its history decimated, into DIR (e.g. '
+                         'config/calibration/runs/coarse_cal), where --resume takes it as done: a sweep that '
+                         'outlives its machine goes on from a fresh clone')
+    ap.add_argument('--commit', action='store_true',
+                    help='commit each file --keep writes, on its own, as its run ends')
     return ap
 
 
@@ -315,6 +322,8 @@ def check_args(a):
     stray = [f for f, _ in a.seeds_at if f not in a.f]
     if stray:
         sys.exit('dm-calibrate: --seeds-at %g: not one of the --f values' % stray[0])
+    if a.commit and not a.keep:
+        sys.exit('dm-calibrate: --commit commits what --keep DIR writes: name the folder')
     if a.install and a.install.endswith(os.sep) and not os.path.isdir(a.install):
         sys.exit('dm-calibrate: --install %s: no such directory' % a.install)
     if len(set(a.f)) < 2 or not a.mu:
@@ -363,15 +372,32 @@ def make_sweep(a, conditions, scene_sha, soil_sha):
             return False
 
     # the scene, its level and soil as the runs are made with them: a resume with others is refused
+    # (and in --keep, which a resume from another checkout reads: the scene by its hash there)
+    options = {'scene_sha256': scene_sha, 'soil_sha256': soil_sha, '--fidelity': a.fidelity, 'conditions': conditions}
     try:
-        keep_options(a.out, {'--scene': os.path.abspath(a.scene), 'scene_sha256': scene_sha, 'soil_sha256': soil_sha,
-                             '--fidelity': a.fidelity, 'conditions': conditions}, a.resume)
+        keep_options(a.out, dict(options, **{'--scene': os.path.abspath(a.scene)}), a.resume)
+        if a.keep:
+            keep_options(a.keep, options, a.resume)
     except ValueError as e:
         sys.exit('dm-calibrate: %s' % e)
+    commit = git_commit(ROOT)
+
+    def keep(o):
+        """A good run's compact result into --keep (committed with --commit) as it ends."""
+        if not a.keep or not o.ok:
+            return
+        path, why = dm_keep.keep_run(o.result_file, a.keep, o.name, commit=a.commit, root=ROOT,
+                                     message='calibration: run %s at %s (%s)' % (o.name, a.fidelity, describe(o)),
+                                     extra={'kept_from_commit': commit},
+                                     also=[os.path.join(a.keep, dm_keep.OPTIONS_FILE)])
+        sweep.line('           kept   %-14s %s' % (o.name, path if why is None else 'NOT KEPT: %s' % why))
+
     sweep = dm_sweep.Sweep(cases, command, os.path.join(a.out, 'runs'), jobs=a.jobs, port=a.port,
                            timeout=a.timeout, check=check, outputs=lambda case: [bag_path(a.out, case.name)],
-                           describe=describe, poll=1.0, status_every=20.0)
+                           describe=describe, poll=1.0, status_every=20.0, on_done=keep)
     if a.resume:
+        if a.keep:
+            dm_keep.restore_kept(a.keep, sweep.runs_dir, [c.name for c in cases], sweep.outcome_file)
         sweep.resume(accept=same_run)
     return cases, sweep
 

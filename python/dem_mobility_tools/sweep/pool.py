@@ -92,6 +92,8 @@ class Sweep:
     result_of: callable case -> the path of its result file (default <runs_dir>/<name>.result.yaml).
     clear_result: delete a run's result file before it starts (default; False where the command
       itself decides, e.g. `doe case` under its lock).
+    on_done: callable outcome -> None, called as each run of this sweep finishes (good or not), before
+      the next starts: e.g. keeping a good run's result in git (dm_sweep.keep).
     weight: callable case -> its estimated cost [s] (default 1 each): the progress bar counts in it
       and each finished run's line gives an ETA (the weight left, at the rate of the weight done so
       far in this sweep).
@@ -103,7 +105,7 @@ class Sweep:
     def __init__(self, cases, command, runs_dir, jobs=1, port=11411, timeout=None, check=None, outputs=None,
                  env=None, describe=None, progress='auto', poll=1.0, status_every=20.0,
                  progress_marker='progress:', kill_grace=30.0, stream=None, accept_status=(), result_of=None,
-                 weight=None, clear_result=True):
+                 weight=None, clear_result=True, on_done=None):
         if jobs < 1:
             raise ValueError('jobs must be >= 1')
         self.accept_status = tuple(accept_status)
@@ -131,6 +133,7 @@ class Sweep:
         self.t0 = None
         self.result_of = result_of
         self.clear_result = clear_result
+        self.on_done = on_done
         self.weighted = weight is not None
         self.weight = weight or (lambda case: 1.0)
         self.outcomes = [Outcome(c, self.result_path(c), self.log_path(c)) for c in self.cases]
@@ -214,9 +217,12 @@ class Sweep:
                 break
         return slot, port
 
+    def outcome_file(self, name):
+        """Where the end of the run of case `name` is kept (ok, error, exit status), for a later resume."""
+        return os.path.join(self.runs_dir, name + '.outcome.yaml')
+
     def _outcome_file(self, o):
-        """Where a run's end is kept (ok, error, exit status), for a later resume."""
-        return os.path.join(self.runs_dir, o.name + '.outcome.yaml')
+        return self.outcome_file(o.name)
 
     def _record(self, o, stopped=False):
         """How the run's process ended (not what its result says: a later sweep judges that by its
@@ -356,6 +362,8 @@ class Sweep:
                     self._finish(o)
                     running.remove(o)
                     ports.append(o.slot)
+                    if self.on_done is not None:
+                        self.on_done(o)
                     finished += 1
                     w = self.weight(o.case)
                     w_done += w

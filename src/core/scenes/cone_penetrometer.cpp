@@ -293,6 +293,7 @@ ConeResult ConePenetrometer::Result() const {
   if (prep_->height_poured() > 0.0) r.density_poured = mass / (area * prep_->height_poured());
   if (prep_->height_consolidated() > 0.0) r.density_consolidated = mass / (area * prep_->height_consolidated());
   r.lid_pressure_reached = prep_->lid_pressure_reached();
+  r.rest = prep_->rest();
   r.samples = samples_;
   // the cone index: the samples in the window, their scatter and their trend with depth
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
@@ -360,6 +361,7 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
   f.Set("bulk_density_poured", r.density_poured);
   f.Set("bulk_density_consolidated", r.density_consolidated);
   f.Set("lid_pressure_reached", r.lid_pressure_reached);
+  DescribeRest(r.rest, "settle_", &f);
   f.Set("time_step", r.time_step);
   f.Set("steps", r.steps);
   f.Set("preparation_time", r.prep_time);

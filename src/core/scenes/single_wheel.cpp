@@ -385,6 +385,7 @@ ResultFile SingleWheelResultFile(const SingleWheelRig& rig) {
   if (bin.preparation().height_consolidated() > 0.0)
     f.Set("bulk_density_consolidated", mass / (area * (bin.preparation().height_consolidated() - p.bin.origin.z())));
   f.Set("lid_pressure_reached", bin.preparation().lid_pressure_reached());
+  DescribeRest(bin.preparation().rest(), "settle_", &f);
   f.SetFlow("bin", {l.length, l.width, l.soil_depth});
   f.Set("time_step", l.time_step);
   f.Set("steps", s.step_count());

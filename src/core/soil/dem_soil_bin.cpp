@@ -211,6 +211,7 @@ void DemSoilBin::DescribeEnergy(ResultFile* r) const {
   const TimeStepLimit lim = dem_->CriticalTimeStep();
   r->Set("soil_critical_time_step", lim.dt_crit);
   r->Set("soil_critical_detail", lim.detail);
+  DescribeRest(prep_->rest(), "soil_settle_", r);
   if (watch_.samples == 0) return;
   const EnergyReport e = dem_->Energy();
   r->Set("soil_energy_wall_work", e.wall_work - watch_start_.wall_work);

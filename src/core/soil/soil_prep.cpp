@@ -100,7 +100,11 @@ SoilPreparation::SoilPreparation(const SoilPreparation& o, DemSystem* s)
       phase_(o.phase_),
       phase_steps_(o.phase_steps_),
       height_poured_(o.height_poured_),
-      height_consolidated_(o.height_consolidated_) {
+      height_consolidated_(o.height_consolidated_),
+      rest_(o.rest_),
+      rest_plastic0_(o.rest_plastic0_),
+      rest_plastic_last_(o.rest_plastic_last_),
+      ledger_before_(o.ledger_before_) {
   if (o.hold_) {
     hold_ = std::make_unique<LidHold>(*o.hold_);
     hold_->Rebind(s);
@@ -199,17 +203,60 @@ void SoilPreparation::Step() {
       break;
     }
     case Phase::kRelease:
+      if (phase_steps_ == 0) WatchRest(true);
       if (phase_steps_ < steps_of(p_.release_time)) {
         s_->Step();
         ++phase_steps_;
+        if (phase_steps_ % std::max(1L, steps_of(rest_.interval)) == 0) WatchRest(false);
       }
       if (phase_steps_ >= steps_of(p_.release_time)) {
         height_consolidated_ = LayerHeight(*s_);
+        s_->set_plastic_ledger(ledger_before_);
         NextPhase(Phase::kDone);
       }
       break;
     case Phase::kDone: break;
   }
+}
+
+void SoilPreparation::WatchRest(bool first) {
+  if (first) {  // the ledger on through the release (it only watches: the states are the same)
+    ledger_before_ = s_->plastic_ledger();
+    s_->set_plastic_ledger(true);
+    rest_ = RestWatch();
+    rest_plastic0_ = rest_plastic_last_ = s_->plastic_exchange();
+    return;
+  }
+  const double t = phase_steps_ * s_->dt(), e = s_->plastic_exchange();
+  rest_.median_speed = MedianParticleSpeed(*s_);
+  rest_.kinetic = s_->Energy().kinetic;
+  rest_.kinetic_max = std::max(rest_.kinetic_max, rest_.kinetic);
+  if (rest_.time_to_rest < 0.0 && rest_.median_speed < RestWatch::kRestSpeed) rest_.time_to_rest = t;
+  rest_.plastic = e - rest_plastic0_;
+  rest_.plastic_max_power = std::max(rest_.plastic_max_power, (e - rest_plastic_last_) / (t - rest_.watched));
+  rest_plastic_last_ = e;
+  rest_.watched = t;
+  ++rest_.samples;
+}
+
+void DescribeRest(const RestWatch& w, const std::string& prefix, ResultFile* r) {
+  r->Set(prefix + "median_speed", w.median_speed);
+  r->Set(prefix + "time", w.time_to_rest);
+  r->Set(prefix + "kinetic", w.kinetic);
+  r->Set(prefix + "kinetic_max", w.kinetic_max);
+  r->Set(prefix + "plastic_work", w.plastic);
+  r->Set(prefix + "plastic_max_power", w.plastic_max_power);
+  r->Set(prefix + "watched", w.watched);
+}
+
+double MedianParticleSpeed(const DemSystem& s) {
+  std::vector<double> speed;
+  speed.reserve(s.num_alive());
+  s.ForEachParticle([&](int, const Vector3d&, const Vector3d& v) { speed.push_back(v.norm()); });
+  if (speed.empty()) return 0.0;
+  const auto mid = speed.begin() + static_cast<long>(speed.size() / 2);
+  std::nth_element(speed.begin(), mid, speed.end());
+  return *mid;
 }
 
 double LayerHeight(const DemSystem& s) {
@@ -264,6 +311,8 @@ template <class Ar>
 void SoilPreparation::Io(Ar& ar) {
   ar.Tag("preparation");
   ar(phase_, phase_steps_, height_poured_, height_consolidated_);
+  rest_.Io(ar);
+  ar(rest_plastic0_, rest_plastic_last_, ledger_before_);
   unsigned char has_hold = hold_ ? 1 : 0;
   ar(has_hold);
   if constexpr (Ar::kLoading) {

@@ -132,6 +132,9 @@ class DemSystem {
   std::vector<Eigen::Vector3d> velocities() const;
   std::vector<double> plastic_deformations() const;
   const SoilParams& soil() const { return soil_; }
+  /// Sets V_relax (eq. 16) from the next step on: how a bed at rest answers its plastic
+  /// deformation being let relax (soil_rest_test), a study of V_relax.
+  void set_relax_speed(double v) { soil_.relax_speed = v; }
   double mass() const { return mass_; }
   long neighbour_builds() const { return builds_; }
   /// Builds of the wall candidates (with every neighbour build, and on their own when walls move).
@@ -153,6 +156,7 @@ class DemSystem {
   /// then `dissipated` is what the dampers and the friction took, never negative in a stable run.
   /// Off by default (a pass over the pairs after every step in which a plastic deformation changed).
   void set_plastic_ledger(bool on) { plastic_ledger_ = on; }
+  bool plastic_ledger() const { return plastic_ledger_; }
   /// The law's plastic exchange since set_plastic_ledger(true) [J].
   double plastic_exchange() const { return ledger_.plastic; }
   /// Bytes held for the particles, neighbour lists, contact histories and walls.
@@ -166,7 +170,7 @@ class DemSystem {
 
  private:
   void Rebuild();
-  /// The forces, maxima and overlaps (f, max_repulsion, max_tension, overlap) at the present state.
+  /// The forces, maxima and overlaps (f, the plastic drive's sums, overlap) at the present state.
   void ComputeForces();
   /// Sums the pair and wall forces into the slots' sums (ps_.sums); `packed`: the step's drift
   /// packed every slot already (else they are packed here).

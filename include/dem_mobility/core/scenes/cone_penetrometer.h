@@ -89,6 +89,7 @@ struct ConeResult {
   double surface_height = 0.0;       ///< soil surface after the preparation [m]
   double density_poured = 0.0, density_consolidated = 0.0;  ///< bulk [kg/m^3]
   double lid_pressure_reached = 0.0; ///< mean over the hold [Pa]
+  RestWatch rest;                    ///< how the bed came to rest after the lid
   double cone_index_psi = 0.0;               ///< mean over the window: the cone index
   double cone_index_std_psi = 0.0;           ///< scatter of the samples in the window
   double cone_index_trend_psi_per_m = 0.0;   ///< slope of CI over tip depth in the window

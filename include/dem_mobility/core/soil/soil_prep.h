@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_system.h"
 
@@ -82,6 +83,35 @@ class LidHold {
   long samples_ = 0;
 };
 
+/// How the released bed comes to rest (the release phase, sampled every `interval`): its median
+/// particle speed, its kinetic energy, and the energy the soil law's plastic changes put into the
+/// particles' contacts (the DEM's plastic ledger, on through the release; > 0: energy the plastic
+/// deformations store, which the bed then turns into motion).
+struct RestWatch {
+  static constexpr double kRestSpeed = 1e-3;  ///< [m/s] a median particle speed below it: at rest
+  double interval = 0.01;       ///< [s] between samples
+  double median_speed = 0.0;    ///< [m/s] at the last sample
+  double kinetic = 0.0;         ///< [J] at the last sample
+  double kinetic_max = 0.0;     ///< [J] largest at a sample
+  double time_to_rest = -1.0;   ///< [s] since the release, first sample at rest; < 0: never
+  double plastic = 0.0;         ///< [J] the plastic exchange over the release
+  double plastic_max_power = 0.0;  ///< [W] its largest mean over a sample interval
+  double watched = 0.0;         ///< [s] of release sampled
+  int samples = 0;
+  template <class Ar>
+  void Io(Ar& ar) {
+    ar(median_speed, kinetic, kinetic_max, time_to_rest, plastic, plastic_max_power, watched, samples);
+  }
+};
+
+/// The watch's figures in a result file, each name after `prefix` ("settle_"): median_speed, time
+/// (since the release, when the median speed first fell below kRestSpeed; -1: not by its end),
+/// kinetic, kinetic_max, plastic_work, plastic_max_power, watched (the release's length sampled).
+void DescribeRest(const RestWatch& w, const std::string& prefix, ResultFile* r);
+
+/// The median speed of the live particles [m/s] (0 without particles).
+double MedianParticleSpeed(const DemSystem& s);
+
 struct SoilPreparationParams {
   double settle_time = 0.5;      ///< [s] after the pour, before the lid
   double lid_pressure = 33.3e3;  ///< [Pa]
@@ -115,12 +145,15 @@ class SoilPreparation {
   double height_poured() const { return height_poured_; }              ///< layer height before the lid [m]
   double height_consolidated() const { return height_consolidated_; }  ///< after the release [m]
   double lid_pressure_reached() const { return hold_ ? hold_->mean_pressure() : 0.0; }  ///< [Pa]
+  /// How the bed came to rest after the lid (filled in through the release).
+  const RestWatch& rest() const { return rest_; }
   /// Its state in a checkpoint (common/state_archive.h): the phase, its steps, the lid's hold.
   template <class Ar>
   void Io(Ar& ar);
 
  private:
   void NextPhase(Phase next);
+  void WatchRest(bool first);
   DemSystem* s_;
   int lid_;
   double area_, park_z_;
@@ -130,6 +163,9 @@ class SoilPreparation {
   long phase_steps_ = 0;
   std::unique_ptr<LidHold> hold_;
   double height_poured_ = 0.0, height_consolidated_ = 0.0;
+  RestWatch rest_;
+  double rest_plastic0_ = 0.0, rest_plastic_last_ = 0.0;  // the ledger at the release's start, at the last sample
+  bool ledger_before_ = false;                           // the DEM's plastic ledger before the release
 };
 
 /// Height of a particle layer: the mean top of the highest 5 % of the particles.
