@@ -229,7 +229,10 @@ void SoilPreparation::WatchRest(bool first) {
   }
   const double t = phase_steps_ * s_->dt(), e = s_->plastic_exchange();
   rest_.median_speed = MedianParticleSpeed(*s_);
-  rest_.kinetic = s_->Energy().kinetic;
+  // (the kinetic energy alone: DemSystem::Energy would also sum every contact's elastic energy)
+  double v2 = 0.0;
+  s_->ForEachParticle([&](int, const Vector3d&, const Vector3d& v) { v2 += v.squaredNorm(); });
+  rest_.kinetic = 0.5 * s_->mass() * v2;
   rest_.kinetic_max = std::max(rest_.kinetic_max, rest_.kinetic);
   if (rest_.time_to_rest < 0.0 && rest_.median_speed < RestWatch::kRestSpeed) rest_.time_to_rest = t;
   rest_.plastic = e - rest_plastic0_;
