@@ -136,7 +136,7 @@ double StreamingRate(const DemSystem& s, int threads, int steps) {
       ps.StartSums(i, weight);
       if (OverlapTrips(ps, i, overlap_limit)) tripped = std::min(tripped, i);
       if (!ps.held[i]) ps.v[i] += h * inv_m * ps.f[i];
-      sum += ps.plastic[i] * ps.max_repulsion[i] + ps.adhesion_max[i] * ps.max_tension[i];
+      sum += ps.plastic[i] * ps.max_repulsion[i] + ps.adhesion_max[i] * ps.normal_sum[i] + ps.adhesion_reach[i];
     }
     check += max_disp2 + sum + tripped;
   }

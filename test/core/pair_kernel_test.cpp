@@ -45,7 +45,7 @@ class VectorInstance : public ::testing::TestWithParam<PairKernel> {
 // What one sweep produces.
 struct SweepOut {
   std::vector<Vector3d> f, spring;
-  std::vector<double> max_repulsion, max_tension, overlap;
+  std::vector<double> max_repulsion, normal_sum, adhesion_reach, contacts, overlap;
   std::vector<unsigned char> touching;
 };
 
@@ -53,10 +53,10 @@ SweepOut Sweep(const SoilContactLaw& law, double D, double dt, int threads, Part
                PairKernel kernel) {
   for (int i = 0; i < ps.slots(); ++i) {
     ps.f[i].setZero();
-    ps.max_repulsion[i] = ps.max_tension[i] = ps.overlap[i] = 0.0;
+    ps.max_repulsion[i] = ps.normal_sum[i] = ps.adhesion_reach[i] = ps.contacts[i] = ps.overlap[i] = 0.0;
   }
   SweepPairs(law, D, dt, threads, &ps, &lists, kernel);
-  SweepOut o{ps.f, {}, ps.max_repulsion, ps.max_tension, ps.overlap, lists.touching()};
+  SweepOut o{ps.f, {}, ps.max_repulsion, ps.normal_sum, ps.adhesion_reach, ps.contacts, ps.overlap, lists.touching()};
   for (const TangentialHistory& h : lists.histories()) o.spring.push_back(h.spring);
   return o;
 }
@@ -66,7 +66,9 @@ void ExpectSameBits(const SweepOut& a, const SweepOut& b, const char* what) {
   int bad = 0;
   for (size_t i = 0; i < a.f.size(); ++i)
     bad += !SameBits(a.f[i], b.f[i]) || !SameBits(a.max_repulsion[i], b.max_repulsion[i]) ||
-           !SameBits(a.max_tension[i], b.max_tension[i]) || !SameBits(a.overlap[i], b.overlap[i]);
+           !SameBits(a.normal_sum[i], b.normal_sum[i]) || !SameBits(a.adhesion_reach[i], b.adhesion_reach[i]) ||
+           !SameBits(a.contacts[i], b.contacts[i]) ||
+           !SameBits(a.overlap[i], b.overlap[i]);
   for (size_t k = 0; k < a.spring.size(); ++k) bad += !SameBits(a.spring[k], b.spring[k]) || a.touching[k] != b.touching[k];
   EXPECT_EQ(bad, 0) << what << ": slots or contacts that differ from the scalar kernel";
 }
@@ -165,10 +167,15 @@ TEST_P(VectorInstance, GivesTheScalarKernelsResultsBitForBitOnEveryBranch) {
   for (int c : {skin, adhesion, repulsion, loading, unloading, stick, slip, no_cohesion}) EXPECT_GT(c, 50);
 
   const SweepOut ref = Sweep(law, D, dt, 1, ps, lists, PairKernel::kScalar);
-  // the outputs that drive the plastic relaxation: particles whose tension exceeds their repulsion
-  int relaxing = 0;
-  for (int i = 0; i < ps.slots(); ++i) relaxing += ref.max_tension[i] > ref.max_repulsion[i];
-  EXPECT_GT(relaxing, 50) << "particles that would relax (tension above repulsion)";
+  // the outputs that drive the plastic relaxation (PlasticDrive): particles pulled apart on the
+  // whole, and particles with adhesive contacts whose adhesion is their partner's (no reach)
+  int pulled = 0, reach_elsewhere = 0;
+  for (int i = 0; i < ps.slots(); ++i) {
+    pulled += ref.normal_sum[i] < 0.0;
+    reach_elsewhere += ref.normal_sum[i] < 0.0 && ref.adhesion_reach[i] == 0.0;
+  }
+  EXPECT_GT(pulled, 50) << "particles pulled apart";
+  EXPECT_GT(reach_elsewhere, 20) << "pulled particles whose adhesion is their partners'";
   for (int threads : {1, 2}) {
     SCOPED_TRACE(threads);
     ExpectSameBits(ref, Sweep(law, D, dt, threads, ps, lists, kernel), PairKernelName(kernel));
@@ -324,10 +331,10 @@ TEST_P(VectorInstance, TakesSlotsWithoutPairsInTheirTurnInABlock) {
     NeighbourList l = lists;
     for (int i = 0; i < p.slots(); ++i) {
       p.f[i] = Vector3d(-0.0, -0.0, -0.0);
-      p.max_repulsion[i] = p.max_tension[i] = p.overlap[i] = 0.0;
+      p.max_repulsion[i] = p.normal_sum[i] = p.adhesion_reach[i] = p.contacts[i] = p.overlap[i] = 0.0;
     }
     SweepPairs(law, D, dt, threads, &p, &l, k);
-    SweepOut o{p.f, {}, p.max_repulsion, p.max_tension, p.overlap, l.touching()};
+    SweepOut o{p.f, {}, p.max_repulsion, p.normal_sum, p.adhesion_reach, p.contacts, p.overlap, l.touching()};
     for (const TangentialHistory& h : l.histories()) o.spring.push_back(h.spring);
     return o;
   };

@@ -252,7 +252,8 @@ void DemSystem::Step() {
     if (OverlapTrips(ps_, i, overlap_limit)) tripped = std::min(tripped, i);
     if (!ps_.held[i]) v[i] += h * inv_m * f[i];
     const double p0 = ps_.plastic[i], a0 = ps_.adhesion_max[i];
-    const double dp = UpdatePlasticDeformation(soil_, p0, ps_.max_repulsion[i], ps_.max_tension[i], dt_);
+    const double dp = UpdatePlasticDeformation(
+        soil_, p0, a0, PlasticDrive{ps_.max_repulsion[i], ps_.normal_sum[i], ps_.adhesion_reach[i], ps_.contacts[i]}, dt_);
     if (dp != p0) {
       ps_.plastic[i] = dp;
       ps_.adhesion_max[i] = MaxAdhesionForce(soil_, dp);

@@ -95,7 +95,8 @@ void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int thre
     const double pi = plastic[i], ai = adhesion_max[i];
     Vector3d fi = Vector3d::Zero();
     PairSums& si = sums[i];
-    double max_rep = si.max_repulsion, max_ten = si.max_tension, max_overlap = si.overlap;
+    double max_rep = si.max_repulsion, normal_sum = si.normal_sum, reach_sum = si.adhesion_reach;
+    double contacts = si.contacts, max_overlap = si.overlap;
     for (int k = nbr_begin[i]; k < nbr_end[i]; ++k) {
       const int j = nbr[k];
       const Vector3d r = xi - x[j];
@@ -124,24 +125,35 @@ void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int thre
       const Vector3d nrm = r * (1.0 / dist);  // from j toward i
       const Vector3d vr = vi - v[j];
       const double vn = vr.dot(nrm);
-      const SoilNormalForce fn = law.Normal(d, -vn, std::min(ai, adhesion_max[j]));
+      const double aj = adhesion_max[j];
+      const SoilNormalForce fn = law.Normal(d, -vn, std::min(ai, aj));
       const Vector3d vt = vr - vn * nrm;
       const Vector3d fc = fn.Total() * nrm + law.Tangential(nrm, vt, fn.repulsion, dt, &hist[k]);
       fi += fc;
       sj.f[0] -= fc.x();
       sj.f[1] -= fc.y();
       sj.f[2] -= fc.z();
+      // the plastic drive (PlasticDrive): the elastic normal force on both, the reach on the end(s)
+      // whose adhesion is the pair's
+      const double elastic = fn.adhesion + fn.repulsion;
+      const double reach = law.cohesion ? AdhesionReach(law.d0, law.dp, law.inv_dp, law.inv_d0_dp, d) : 0.0;
       max_rep = std::max(max_rep, fn.repulsion);
-      max_ten = std::max(max_ten, -fn.adhesion);
+      normal_sum += elastic;
+      reach_sum += ai <= aj ? reach : 0.0;
+      contacts += 1.0;
       sj.max_repulsion = std::max(sj.max_repulsion, fn.repulsion);
-      sj.max_tension = std::max(sj.max_tension, -fn.adhesion);
+      sj.normal_sum += elastic;
+      sj.adhesion_reach += aj <= ai ? reach : 0.0;
+      sj.contacts += 1.0;
       touching[k] = 1;
     }
     si.f[0] += fi.x();
     si.f[1] += fi.y();
     si.f[2] += fi.z();
     si.max_repulsion = max_rep;
-    si.max_tension = max_ten;
+    si.normal_sum = normal_sum;
+    si.adhesion_reach = reach_sum;
+    si.contacts = contacts;
     si.overlap = max_overlap;
   };
   const std::vector<SlotState>& state = ps->state;
@@ -157,7 +169,7 @@ void SweepScalar(const SoilContactLaw& law, double diameter, double dt, int thre
 
 // The law's constants as the block loop reads them (the scalar law's, worked out the same way).
 struct LawConstants {
-  double D, D2, dt, k_n, c_n, d0, inv_dp, inv_d0_dp, s_n;
+  double D, D2, dt, k_n, c_n, d0, dp, inv_dp, inv_d0_dp, s_n;
   double mu, k_t, inv_k_t, v_slip, c_visc;
   bool cohesion;
 };
@@ -176,9 +188,12 @@ struct alignas(64) Block {
   double rx[kBlock], ry[kBlock], rz[kBlock];     // x_i - x_j
   double vx[kBlock], vy[kBlock], vz[kBlock];     // v_i - v_j
   double psum[kBlock], amax[kBlock];             // plastic_i + plastic_j, min(adhesion_i, adhesion_j)
+  double own_i[kBlock], own_j[kBlock];           // 1: the pair's adhesion is i's (j's), adhesion_i <= adhesion_j
   double sx[kBlock], sy[kBlock], sz[kBlock];     // the anchor spring: in, and out
   double fx[kBlock], fy[kBlock], fz[kBlock];     // the contact force on i
-  double rep[kBlock], ten[kBlock], ovl[kBlock];  // repulsion, tension (-adhesion), overlap
+  double rep[kBlock], ovl[kBlock];               // repulsion, overlap
+  double elastic[kBlock];                        // adhesion + repulsion
+  double reach_i[kBlock], reach_j[kBlock];       // AdhesionReach on the end(s) whose adhesion is the pair's
   double contact[kBlock];                        // 1: in contact (d > 0)
 };
 
@@ -207,7 +222,9 @@ template <bool kCohesion>
     const double adhesion = kCohesion ? -fa * tri : 0.0;
     const double repulsion = c.k_n * std::max(0.0, d - c.d0);
     const double damping = c.c_n * (std::max(d_dot, 0.0) + c.s_n * std::min(d_dot, 0.0));
-    const double total = (adhesion + repulsion) + damping;
+    const double elastic = adhesion + repulsion;
+    const double total = elastic + damping;
+    const double reach = kCohesion ? AdhesionReach(c.d0, c.dp, c.inv_dp, c.inv_d0_dp, d) : 0.0;
     // the tangential force (SoilContactLaw::Tangential, AsperityFriction::Force)
     const double vtx = vx - vn * nx, vty = vy - vn * ny, vtz = vz - vn * nz;
     double sx = b->sx[l], sy = b->sy[l], sz = b->sz[l];
@@ -246,7 +263,9 @@ template <bool kCohesion>
     b->fy[l] = contact ? total * ny + fty : 0.0;
     b->fz[l] = contact ? total * nz + ftz : 0.0;
     b->rep[l] = contact ? repulsion : 0.0;
-    b->ten[l] = contact ? -adhesion : 0.0;
+    b->elastic[l] = contact ? elastic : 0.0;
+    b->reach_i[l] = contact ? reach * b->own_i[l] : 0.0;
+    b->reach_j[l] = contact ? reach * b->own_j[l] : 0.0;
     b->ovl[l] = skin ? overlap : 0.0;
     b->contact[l] = contact ? 1.0 : 0.0;
   }
@@ -271,6 +290,8 @@ template <bool kCohesion>
     b->vz[q] = vi2 - pj.v[2];
     b->psum[q] = plastic_i + pj.plastic;
     b->amax[q] = std::min(adhesion_i, pj.adhesion_max);
+    b->own_i[q] = adhesion_i <= pj.adhesion_max ? 1.0 : 0.0;
+    b->own_j[q] = pj.adhesion_max <= adhesion_i ? 1.0 : 0.0;
     const Vector3d& sp = a.hist[k0 + l].spring;
     b->sx[q] = sp.x();
     b->sy[q] = sp.y();
@@ -282,22 +303,30 @@ template <bool kCohesion>
 [[gnu::always_inline]] inline void PadLanes(const LawConstants& c, int m, int n, Block* b) {
   for (int l = m; l < n; ++l) {
     b->rx[l] = b->ry[l] = b->rz[l] = 2.0 * c.D;
-    b->vx[l] = b->vy[l] = b->vz[l] = b->psum[l] = b->amax[l] = 0.0;
+    b->vx[l] = b->vy[l] = b->vz[l] = b->psum[l] = b->amax[l] = b->own_i[l] = b->own_j[l] = 0.0;
     b->sx[l] = b->sy[l] = b->sz[l] = 0.0;
   }
 }
 
-// What one slot's sweep carries from block to block: its force sum and its maxima.
+// What one slot's sweep carries from block to block: its force sum, its plastic drive and its
+// largest overlap.
 struct SlotSums {
   double f0 = 0.0, f1 = 0.0, f2 = 0.0;
-  double max_rep, max_ten, max_overlap;
-  explicit SlotSums(const PairSums& s) : max_rep(s.max_repulsion), max_ten(s.max_tension), max_overlap(s.overlap) {}
+  double max_rep, normal_sum, reach_sum, contacts, max_overlap;
+  explicit SlotSums(const PairSums& s)
+      : max_rep(s.max_repulsion),
+        normal_sum(s.normal_sum),
+        reach_sum(s.adhesion_reach),
+        contacts(s.contacts),
+        max_overlap(s.overlap) {}
   void Into(PairSums* s) const {
     s->f[0] += f0;
     s->f[1] += f1;
     s->f[2] += f2;
     s->max_repulsion = max_rep;
-    s->max_tension = max_ten;
+    s->normal_sum = normal_sum;
+    s->adhesion_reach = reach_sum;
+    s->contacts = contacts;
     s->overlap = max_overlap;
   }
 };
@@ -318,9 +347,13 @@ struct SlotSums {
     sj.f[1] -= b->fy[q];
     sj.f[2] -= b->fz[q];
     si->max_rep = std::max(si->max_rep, b->rep[q]);
-    si->max_ten = std::max(si->max_ten, b->ten[q]);
+    si->normal_sum += b->elastic[q];
+    si->reach_sum += b->reach_i[q];
     sj.max_repulsion = std::max(sj.max_repulsion, b->rep[q]);
-    sj.max_tension = std::max(sj.max_tension, b->ten[q]);
+    sj.normal_sum += b->elastic[q];
+    sj.adhesion_reach += b->reach_j[q];
+    si->contacts += b->contact[q];
+    sj.contacts += b->contact[q];
     a.hist[k].spring = Vector3d(b->sx[q], b->sy[q], b->sz[q]);
     a.touching[k] = static_cast<unsigned char>(b->contact[q] != 0.0);
   }
@@ -455,8 +488,8 @@ bool CpuHasAvx2() {
 
 LawConstants ConstantsOf(const SoilContactLaw& law, double diameter, double dt) {
   const AsperityFriction& fr = law.friction;
-  return LawConstants{diameter, diameter * diameter, dt,   law.k_n,  law.c_n, law.d0,   law.inv_dp,  law.inv_d0_dp,
-                      law.s_n,  fr.mu,                 fr.k_t, fr.inv_k_t, fr.v_slip, fr.c_visc, law.cohesion};
+  return LawConstants{diameter, diameter * diameter, dt,     law.k_n,    law.c_n,   law.d0,    law.dp,      law.inv_dp,
+                      law.inv_d0_dp, law.s_n, fr.mu, fr.k_t, fr.inv_k_t, fr.v_slip, fr.c_visc, law.cohesion};
 }
 
 void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, double dt, int threads,
@@ -521,7 +554,9 @@ void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threa
     ps->PackFresh(i, ps->f[i]);
     PairSums& s = ps->sums[i];
     s.max_repulsion = ps->max_repulsion[i];
-    s.max_tension = ps->max_tension[i];
+    s.normal_sum = ps->normal_sum[i];
+    s.adhesion_reach = ps->adhesion_reach[i];
+    s.contacts = ps->contacts[i];
     s.overlap = ps->overlap[i];
   }
   SweepPacked(law, diameter, dt, threads, ps, lists, kernel);
@@ -542,6 +577,8 @@ double PairLawThroughput(PairKernel kernel, const SoilContactLaw& law, double di
     b.vz[l] = -0.01;
     b.psum[l] = 0.0;
     b.amax[l] = 1.0;
+    b.own_i[l] = 1.0;
+    b.own_j[l] = t < 0.5 ? 1.0 : 0.0;
     b.sx[l] = b.sy[l] = b.sz[l] = 0.0;
   }
   using LawOnly = void (*)(const LawConstants&, Block*, long);

@@ -29,7 +29,9 @@ int ParticleStore::Add(const Eigen::Vector3d& x0, const Eigen::Vector3d& v0, con
     plastic.push_back(0.0);
     adhesion_max.push_back(0.0);
     max_repulsion.push_back(0.0);
-    max_tension.push_back(0.0);
+    normal_sum.push_back(0.0);
+    adhesion_reach.push_back(0.0);
+    contacts.push_back(0.0);
     overlap.push_back(0.0);
     state.push_back(SlotState::kFree);
     held.push_back(0);
@@ -43,7 +45,7 @@ int ParticleStore::Add(const Eigen::Vector3d& x0, const Eigen::Vector3d& v0, con
   x_built[p] = x0;
   plastic[p] = 0.0;
   adhesion_max[p] = adhesion0;
-  max_repulsion[p] = max_tension[p] = overlap[p] = 0.0;
+  max_repulsion[p] = normal_sum[p] = adhesion_reach[p] = contacts[p] = overlap[p] = 0.0;
   state[p] = st;
   held[p] = 0;
   return id;
@@ -54,7 +56,7 @@ int ParticleStore::Remove(int id) {
   state[i] = SlotState::kFree;
   held[i] = 0;
   f[i].setZero();
-  max_repulsion[i] = max_tension[i] = overlap[i] = 0.0;
+  max_repulsion[i] = normal_sum[i] = adhesion_reach[i] = contacts[i] = overlap[i] = 0.0;
   ids_[id].state = IdRecord::State::kRemoved;
   ++removed_;
   free_slots_.insert(std::lower_bound(free_slots_.begin(), free_slots_.end(), i), i);
@@ -68,7 +70,9 @@ void ParticleStore::Permute(const std::vector<int>& order) {
   PermuteSlots(&plastic, order, 1);
   PermuteSlots(&adhesion_max, order, 1);
   PermuteSlots(&max_repulsion, order, 1);
-  PermuteSlots(&max_tension, order, 1);
+  PermuteSlots(&normal_sum, order, 1);
+  PermuteSlots(&adhesion_reach, order, 1);
+  PermuteSlots(&contacts, order, 1);
   PermuteSlots(&overlap, order, 1);
   PermuteSlots(&state, order, 1);
   PermuteSlots(&held, order, 1);
@@ -87,7 +91,7 @@ void ParticleStore::Permute(const std::vector<int>& order) {
 size_t ParticleStore::MemoryBytes() const {
   auto bytes = [](const auto& a) { return a.capacity() * sizeof(a[0]); };
   return bytes(x) + bytes(v) + bytes(f) + bytes(x_built) + bytes(plastic) + bytes(adhesion_max) +
-         bytes(max_repulsion) + bytes(max_tension) + bytes(overlap) + bytes(state) + bytes(held) + bytes(id_of_slot) + bytes(hot) + bytes(sums) +
+         bytes(max_repulsion) + bytes(normal_sum) + bytes(adhesion_reach) + bytes(contacts) + bytes(overlap) + bytes(state) + bytes(held) + bytes(id_of_slot) + bytes(hot) + bytes(sums) +
          bytes(ids_) + bytes(free_slots_);
 }
 
@@ -95,14 +99,14 @@ template <class Ar>
 void ParticleStore::Io(Ar& ar) {
   ar.Tag("particles");
   // (not `hot` nor `sums`: the pair kernels' scratch, packed from these arrays before every sweep)
-  ar(x, v, f, x_built, plastic, adhesion_max, max_repulsion, max_tension, overlap, state, held, id_of_slot, ids_,
+  ar(x, v, f, x_built, plastic, adhesion_max, max_repulsion, normal_sum, adhesion_reach, contacts, overlap, state, held, id_of_slot, ids_,
      free_slots_, removed_);
   if constexpr (Ar::kLoading) {
     hot.clear();
     sums.clear();
     const size_t n = x.size();
     for (size_t len : {v.size(), f.size(), x_built.size(), plastic.size(), adhesion_max.size(), max_repulsion.size(),
-                       max_tension.size(), overlap.size(), state.size(), held.size(), id_of_slot.size()})
+                       normal_sum.size(), adhesion_reach.size(), contacts.size(), overlap.size(), state.size(), held.size(), id_of_slot.size()})
       if (len != n) ar.Fail("the particle arrays differ in length");
     const int slots = static_cast<int>(n), ids = static_cast<int>(ids_.size());
     for (const IdRecord& r : ids_)

@@ -366,7 +366,8 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
   const double pi = ps->plastic[i], ai = ps->adhesion_max[i];
   PairSums& si = ps->sums[i];
   Vector3d f(si.f[0], si.f[1], si.f[2]);
-  double max_rep = si.max_repulsion, max_ten = si.max_tension, max_overlap = si.overlap;
+  double max_rep = si.max_repulsion, normal_sum = si.normal_sum, reach_sum = si.adhesion_reach;
+  double contacts = si.contacts, max_overlap = si.overlap;
   auto tri_at = [&](int t) -> const WallTri& { return tris_[fresh ? fresh_tris[t] : tri_of_slot_[t]]; };
   // the walls with no triangle near (most of them: a particle is near one wall or two) only clear
   // what an earlier contact left, walls [w0, w1) at once
@@ -445,8 +446,13 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
     const Vector3d ft = wlaw.Tangential(nrm, vr - vn * nrm, fn.repulsion, dt, &hist_[hw]);
     const Vector3d fc = fn.Total() * nrm + ft;
     f += fc;
+    // the plastic drive (PlasticDrive): a wall's adhesion is its factor times the particle's own
     max_rep = std::max(max_rep, fn.repulsion);
-    max_ten = std::max(max_ten, -fn.adhesion);
+    normal_sum += fn.adhesion + fn.repulsion;
+    if (wlaw.cohesion)
+      reach_sum += wl.adhesion_factor * AdhesionReach(wlaw.d0, wlaw.dp, wlaw.inv_dp, wlaw.inv_d0_dp, d);
+    // (a wall adhering more strongly than a particle counts as that many contacts in the bound)
+    contacts += std::max(1.0, wl.adhesion_factor);
     touching_[hw] = 1;
     sum[w].force -= fc;
     sum[w].moment += (q_best - wl.wrench_point).cross(-fc);
@@ -459,7 +465,9 @@ void WallContacts::ComputeSlot(ParticleStore* ps, int i, double dt, WallSum* sum
   si.f[1] = f.y();
   si.f[2] = f.z();
   si.max_repulsion = max_rep;
-  si.max_tension = max_ten;
+  si.normal_sum = normal_sum;
+  si.adhesion_reach = reach_sum;
+  si.contacts = contacts;
   si.overlap = max_overlap;
 }
 

@@ -16,7 +16,7 @@ namespace {
 // a checkpoint file: this line, the format's version, the state (StateWriter), and the Fnv1a of
 // all the bytes before it (a damaged file is refused before anything of it is read)
 constexpr char kMagic[] = "dem_mobility checkpoint\n";
-constexpr uint32_t kFormat = 3;  // 3: the preparation with its settling watch; 2: the DEM state without its scratch
+constexpr uint32_t kFormat = 3;  // 3: the plastic drive (two sums) in place of the largest tension; 2: no scratch
 }  // namespace
 
 void CheckpointIdentity::CheckRestart(const std::string& checkpoint, const std::string& scene,

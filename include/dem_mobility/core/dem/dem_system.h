@@ -132,6 +132,9 @@ class DemSystem {
   std::vector<Eigen::Vector3d> velocities() const;
   std::vector<double> plastic_deformations() const;
   const SoilParams& soil() const { return soil_; }
+  /// Sets V_relax (eq. 16) from the next step on: how a bed at rest answers its plastic
+  /// deformation being let relax (soil_rest_test), a study of V_relax.
+  void set_relax_speed(double v) { soil_.relax_speed = v; }
   double mass() const { return mass_; }
   long neighbour_builds() const { return builds_; }
   /// Builds of the wall candidates (with every neighbour build, and on their own when walls move).
@@ -167,7 +170,7 @@ class DemSystem {
 
  private:
   void Rebuild();
-  /// The forces, maxima and overlaps (f, max_repulsion, max_tension, overlap) at the present state.
+  /// The forces, maxima and overlaps (f, the plastic drive's sums, overlap) at the present state.
   void ComputeForces();
   /// Sums the pair and wall forces into the slots' sums (ps_.sums); `packed`: the step's drift
   /// packed every slot already (else they are packed here).

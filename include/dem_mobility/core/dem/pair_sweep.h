@@ -37,15 +37,15 @@ PairKernel ResolvePairKernel(PairKernel requested);
 /// "vector-avx512", "vector-avx2", "vector-baseline", "scalar" (kAuto: what it resolves to).
 const char* PairKernelName(PairKernel kernel);
 
-/// Adds the pair forces to each slot's sums (ps->sums: its force and its largest repulsion, tension
-/// and overlap, started beforehand) and updates the contact histories. The slots' records are
+/// Adds the pair forces to each slot's sums (ps->sums: its force, its plastic drive, soil_law.h's
+/// PlasticDrive, and its largest overlap, started beforehand) and updates the contact histories. The slots' records are
 /// packed beforehand (ParticleStore::SizeScratch and PackFresh: the vector kernels gather from
 /// ps->hot; the scalar one reads the per-slot arrays).
 void SweepPacked(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
                  NeighbourList* lists, PairKernel kernel = PairKernel::kAuto);
 
 /// SweepPacked on the per-slot arrays: adds the pair forces to ps->f and updates each particle's
-/// largest repulsion, tension and overlap in max_repulsion, max_tension and overlap (packs the
+/// plastic drive and largest overlap in max_repulsion, normal_sum, adhesion_reach and overlap (packs the
 /// slots from them, sweeps, and unpacks).
 void SweepPairs(const SoilContactLaw& law, double diameter, double dt, int threads, ParticleStore* ps,
                 NeighbourList* lists, PairKernel kernel = PairKernel::kAuto);

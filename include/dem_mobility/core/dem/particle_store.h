@@ -41,11 +41,11 @@ struct alignas(64) HotParticle {
 static_assert(sizeof(HotParticle) == 64, "one cache line");
 
 /// What the pair sweep adds to a partner, in one cache line: the vector kernels sum into it
-/// (copied from f, max_repulsion, max_tension and overlap before each sweep and back after it), so
-/// that a partner's results cost one line and not four.
+/// (copied from f, the plastic drive's sums and overlap before each sweep and back after it), so
+/// that a partner's results cost one line and not five.
 struct alignas(64) PairSums {
   double f[3];
-  double max_repulsion, max_tension, overlap;
+  double max_repulsion, normal_sum, adhesion_reach, contacts, overlap;
 };
 static_assert(sizeof(PairSums) == 64, "one cache line");
 
@@ -58,8 +58,10 @@ class ParticleStore {
   std::vector<Eigen::Vector3d> x_built;  ///< position at the last neighbour build (or at its addition)
   std::vector<double> plastic;           ///< plastic deformation [m]
   std::vector<double> adhesion_max;      ///< maximum adhesion force [N]
-  // the largest repulsion, tension and overlap of the slot's contacts at the last force evaluation
-  std::vector<double> max_repulsion, max_tension, overlap;
+  // of the slot's contacts at the last force evaluation: the largest repulsion, the sum of their
+  // elastic normal forces, the sum of the reach of those whose adhesion is the slot's own, their
+  // number (the plastic update's PlasticDrive, soil_law.h) and the largest overlap
+  std::vector<double> max_repulsion, normal_sum, adhesion_reach, contacts, overlap;
   std::vector<SlotState> state;
   /// 1: held in place (zero velocity, not integrated; its contacts still act on its neighbours)
   std::vector<unsigned char> held;
@@ -67,7 +69,7 @@ class ParticleStore {
   /// x, v, plastic and adhesion_max of every slot, packed before each force evaluation (the vector
   /// pair kernels gather from it; a scratch copy, never the state)
   std::vector<HotParticle> hot;
-  /// f, max_repulsion, max_tension and overlap of every slot while the forces are summed: the pair
+  /// f, max_repulsion, normal_sum, adhesion_reach, contacts and overlap of every slot while the forces are summed: the pair
   /// kernels and the walls add into it, and it is unpacked into those arrays afterwards (scratch
   /// as `hot` is)
   std::vector<PairSums> sums;
@@ -101,19 +103,21 @@ class ParticleStore {
     r.f[0] = f0.x();
     r.f[1] = f0.y();
     r.f[2] = f0.z();
-    r.max_repulsion = r.max_tension = r.overlap = 0.0;
+    r.max_repulsion = r.normal_sum = r.adhesion_reach = r.contacts = r.overlap = 0.0;
   }
   /// Packs slot s for a sweep: its hot record and its sums started at `f0`.
   void PackFresh(int s, const Eigen::Vector3d& f0) {
     PackHot(s);
     StartSums(s, f0);
   }
-  /// Slot s's sums back into f, max_repulsion, max_tension and overlap.
+  /// Slot s's sums back into f, max_repulsion, normal_sum, adhesion_reach, contacts and overlap.
   void Unpack(int s) {
     const PairSums& r = sums[s];
     f[s] = Eigen::Vector3d(r.f[0], r.f[1], r.f[2]);
     max_repulsion[s] = r.max_repulsion;
-    max_tension[s] = r.max_tension;
+    normal_sum[s] = r.normal_sum;
+    adhesion_reach[s] = r.adhesion_reach;
+    contacts[s] = r.contacts;
     overlap[s] = r.overlap;
   }
   bool live(int s) const { return state[s] != SlotState::kFree; }

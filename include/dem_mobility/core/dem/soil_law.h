@@ -1,7 +1,7 @@
 // The cohesive soil particle law of the paper's section 2.3: normal force = adhesion + repulsion +
 // damping (eq. 15, 12b; fig. 7), a per-particle plastic deformation that grows with the particle's
-// largest compressive force (fig. 8), is kept after unloading and relaxes at V_relax while the
-// particle's largest compression is below its largest tension (eq. 16), a maximum adhesion that grows with the
+// largest compressive force (fig. 8), is kept after unloading and relaxes at V_relax while that
+// releases energy, i.e. while the particle is pulled apart (eq. 16), a maximum adhesion that grows with the
 // plastic strain (fig. 10, scaled by the cohesion factor f), and the asperity friction of eq. 13-14
 // (a Coulomb element in parallel with a variable-anchor spring, capped at mu F_repulsion).
 //
@@ -118,26 +118,61 @@ struct SoilContactLaw {
 /// plastic strain delta_p / d, times the area. 0 when cohesion is off.
 double MaxAdhesionForce(const SoilParams& p, double delta_p);
 
-/// One step of a particle's plastic deformation: grows to fig. 8 at the stress of its largest
-/// repulsive force `max_repulsion` (never shrinks from loading), and relaxes by V_relax dt (eq. 16)
-/// while that force is below the largest adhesive (tensile) force `max_tension` its contacts carry
-/// now, or while it has no compression at all; floored at zero and at fig. 8's value for the present
-/// load (see soil_law.cpp). Unchanged when plasticity is off.
-inline double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double max_repulsion, double max_tension,
-                                       double dt) {
+/// The adhesion triangle's integral from 0 to the effective penetration `d` at unit maximum
+/// adhesion [m]: how much a contact's energy falls per newton of maximum adhesion (its adhesive
+/// energy is -f_adh_max times this). 0 for d <= 0, d0 / 2 beyond d0. `inv_dp`, `inv_d0_dp`: as
+/// SoilContactLaw's (no division on a vector lane). Branch-free in `d`, both arms computed.
+[[gnu::always_inline]] inline double AdhesionReach(double d0, double dp, double inv_dp, double inv_d0_dp, double d) {
+  const double a = std::max(0.0, std::min(d, d0)), past = a - dp;
+  const double rising = 0.5 * a * a * inv_dp;
+  const double falling = (0.5 * dp + past) - 0.5 * past * past * inv_d0_dp;
+  return a <= dp ? rising : falling;
+}
+
+/// What a particle's contacts tell its plastic update (summed over them at the last force
+/// evaluation): its largest repulsive force, the sum of their elastic normal forces (adhesion +
+/// repulsion, > 0 pushing it out), the sum of AdhesionReach over the contacts whose maximum
+/// adhesion is the particle's own (a pair takes the smaller of its two, a wall its factor times
+/// the particle's; such a wall contact counts its factor times the reach), and their number (a
+/// wall adhering more than a particle counts its factor).
+struct PlasticDrive {
+  double max_repulsion = 0.0, normal_sum = 0.0, adhesion_reach = 0.0, contacts = 0.0;
+};
+
+/// One step of a particle's plastic deformation `delta_p` (eq. 16 and fig. 8, as read in
+/// docs/soil-model.md, "Reading of eq. 16"): it grows to fig. 8 at the stress of its largest
+/// repulsive force (never shrinks from loading); otherwise it relaxes by V_relax dt, floored at
+/// zero and at fig. 8's value for the present load, when that relaxation releases energy: when,
+/// at the particle's present contacts, the deformation given back (each contact's penetration
+/// deeper by the step) and the adhesion lost with it (f x fig. 10 at the lower strain) together
+/// lower the contacts' stored energy, which is when the particle is pulled apart ("reduction of
+/// soil cohesive strength and soil bulk density due to tension"). Plastic relaxation is then
+/// dissipative, as plastic flow is: it never pushes a bed at rest into motion. `adhesion_max` is
+/// the particle's present MaxAdhesionForce(p, delta_p). Unchanged when plasticity is off.
+inline double UpdatePlasticDeformation(const SoilParams& p, double delta_p, double adhesion_max,
+                                       const PlasticDrive& drive, double dt) {
   // (inline: the DEM step calls it for every particle)
   if (!p.plasticity) return delta_p;
-  const double target = p.plastic_strain_vs_stress(max_repulsion / p.Area()) * p.diameter;
+  const double target = p.plastic_strain_vs_stress(drive.max_repulsion / p.Area()) * p.diameter;
   if (target > delta_p) return target;  // loading beyond the history: the deformation grows (fig. 8)
-  // eq. 16 relaxes the deformation at V_relax "due to tension and/or removal of the compression":
-  // while the particle's largest compressive force is below the largest tensile (adhesive) force
-  // it carries, both taken over its contacts now (the paper's "maximum force value over all adjacent
-  // particles"), or while nothing compresses it (why this reading: docs/soil-model.md, "Reading of eq. 16").
   // Floored at what fig. 8 gives for the present load: only the part left from earlier, higher
   // loads relaxes, so the next step does not grow it back by V_relax dt (a force jump of
   // k_n V_relax dt on a lightly loaded particle).
-  if (max_repulsion < max_tension || max_repulsion <= 0.0) return std::max(target, delta_p - p.relax_speed * dt);
-  return delta_p;
+  const double relaxed = std::max(target, delta_p - p.relax_speed * dt);
+  if (!(relaxed < delta_p)) return delta_p;
+  // The change of the contacts' energy at fixed positions if it relaxes: to first order each
+  // contact's penetration deeper by the step s (its elastic normal force times s) and its adhesive
+  // energy less by the adhesion lost da (its reach times da); plus, per contact, a bound of the
+  // second-order rest: the force's largest slope over the step (k_n, or the adhesion triangle's
+  // falling side, a / (d0 - dp)) times s^2 / 2, and da s (the triangle's slope is at most 1 per
+  // unit a), both doubled for a partner relaxing in the same step (its s deepens the contact too).
+  // A free particle moves no energy and relaxes.
+  const double s = delta_p - relaxed, da = adhesion_max - MaxAdhesionForce(p, relaxed);
+  const double falling = (p.adhesion_depth - p.adhesion_peak) * p.diameter;
+  const double slope = std::max(p.NormalStiffness(), falling > 0.0 ? adhesion_max / falling : 0.0);
+  const double first = s * drive.normal_sum + da * drive.adhesion_reach;
+  const double second = drive.contacts * (slope * s * s + 2.0 * da * s);
+  return first + second <= 0.0 ? relaxed : delta_p;
 }
 
 }  // namespace dem_mobility::core
