@@ -88,6 +88,22 @@ inline std::unique_ptr<DemSoilTerrain> PreparedPatch(double ci, double length = 
   return std::make_unique<DemSoilTerrain>(*t);
 }
 
+/// The mean height of the highest particle centre of each column (d along x, the band's width
+/// across) of the band |y - y0| < half_width, over the columns holding particles.
+inline double TrackTop(const DemSystem& s, double y0, double half_width, double d) {
+  std::map<long, double> top;
+  s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
+    if (std::abs(x.y() - y0) >= half_width) return;
+    const long c = std::lround(std::floor(x.x() / d));
+    auto it = top.find(c);
+    if (it == top.end()) top[c] = x.z();
+    else it->second = std::max(it->second, x.z());
+  });
+  double sum = 0.0;
+  for (const auto& [c, z] : top) sum += z;
+  return top.empty() ? std::numeric_limits<double>::quiet_NaN() : sum / static_cast<double>(top.size());
+}
+
 /// The vehicle's tests: a 6 m box (the vehicle fits with 1.3 m to spare at each end).
 inline constexpr double kShortBox = 6.0;
 
