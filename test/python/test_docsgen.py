@@ -167,3 +167,50 @@ class Status(unittest.TestCase):
 
 if __name__ == '__main__':
     unittest.main()
+
+
+class ConeData(RepoCopy):
+    """dm-docs-cone: a table's runs become the seeds table (mean and std recomputed from the runs
+    agree with the table's points) and its rows the CI -> f table, and dm-docs renders them."""
+
+    def test_seeds_and_table_from_a_calibration_table(self):
+        import yaml
+        from dem_mobility_tools.docsgen import cone_data
+        runs = {0.5: [10.0, 12.0, 14.0], 4.0: [100.0, 90.0, 110.0]}
+        f_list, seeds, ci = [], [], []
+        for f, cis in runs.items():
+            for s, c in enumerate(cis, 1):
+                f_list.append(f)
+                seeds.append(s)
+                ci.append(c)
+        table = {'particle_diameter': 0.07, 'friction': 0.1, 'fidelity': 'x_cal',
+                 'table': [[12.0, 0.5], [50.0, 2.0], [100.0, 4.0]],
+                 'points': {'f': [0.5, 4.0], 'ci_mean': [12.0, 100.0], 'ci_std': [2.0, 10.0], 'seeds': [3, 3]},
+                 'runs': {'f': f_list, 'seed': seeds, 'ci': ci},
+                 'provenance': {'commit': '0123456789', 'date': '2026-12-07', 'conditions': {'cone_speed': 0.1}}}
+        path = os.path.join(self.tmp, 'cone_index_mu0.1_d0.07.yaml')
+        with open(path, 'w') as f:
+            yaml.safe_dump(table, f)
+        seeds_path, table_path = cone_data.write(self.tmp, path, 'a test machine', 'dm-calibrate ...')
+        with open(seeds_path) as f:
+            s = yaml.safe_load(f)
+        self.assertEqual(s['table'], 'cone/seeds_d0.07')
+        self.assertEqual([r['cohesion_factor'] for r in s['rows']], [0.5, 4.0])
+        row = s['rows'][1]
+        got = [float(row['seed_%d' % k]) for k in (1, 2, 3)]
+        self.assertEqual(got, [100.0, 90.0, 110.0])
+        self.assertEqual(row['mean'], '**100.0**')
+        self.assertEqual(row['relative'], '10.0 %')  # std 10 of mean 100
+        with open(table_path) as f:
+            t = yaml.safe_load(f)
+        self.assertEqual([c['title'] for c in t['columns']], ['CI [psi]', '12', '50', '100'])
+        self.assertEqual(float(t['rows'][0]['50']), 2.0)
+        # dm-docs renders both into a doc that names them
+        with open(os.path.join(self.tmp, 'docs', 'cone-penetrometer.md'), 'a') as f:
+            f.write('\n<!-- generated: cone/seeds_d0.07 -->\n<!-- end generated -->\n'
+                    '<!-- generated: cone/table_d0.07 -->\n<!-- end generated -->\n')
+        rc, err = run(['--root', self.tmp])
+        self.assertEqual(rc, 0, err)
+        with open(os.path.join(self.tmp, 'docs', 'cone-penetrometer.md')) as f:
+            text = f.read()
+        self.assertIn('| 4.0 | 100.00 | 90.00 | 110.00 | **100.0** | 10.0 | 10.0 % |', text)

@@ -1,0 +1,143 @@
+"""dm-docs-cone: writes the docs' data files of one cone index table (docs/data/cone-seeds-dD.yaml
+and cone-table-dD.yaml) from the table dm-calibrate installed, for dm-docs to render.
+
+    dm-docs-cone config/calibration/cone_index_mu0.1_d0.06.yaml --machine "..." [--beside TABLE ...]
+
+The seeds table has a row per f: every seed's CI, the mean, the std over the seeds and its
+relative size, and (--beside) the mean CI of other tables at the same f; the table has the
+installed CI -> f rows. The provenance is the table's own (commit, date, command, conditions).
+"""
+import argparse
+import os
+import sys
+
+import yaml
+
+from .make import DocsError, default_root
+
+
+def _load(path):
+    try:
+        with open(path) as f:
+            t = yaml.safe_load(f)
+    except (OSError, yaml.YAMLError) as e:
+        raise DocsError('{}: {}'.format(path, e))
+    for key in ('particle_diameter', 'friction', 'fidelity', 'runs', 'points', 'table', 'provenance'):
+        if not isinstance(t, dict) or key not in t:
+            raise DocsError('{}: missing key {}'.format(path, key))
+    return t
+
+
+def _key(title):
+    return ''.join(c if c.isalnum() else '_' for c in title).strip('_').lower()
+
+
+def _g(v, digits=2):
+    """A number as the docs print it: fixed digits, as a string where YAML would drop a zero."""
+    s = '{:.{}f}'.format(v, digits)
+    return s if s.endswith('0') else float(s)
+
+
+def _mean_at(table, f):
+    p = table['points']
+    for fi, ci in zip(p['f'], p['ci_mean']):
+        if abs(fi - f) < 1e-9:
+            return ci
+    return None
+
+
+def seeds_rows(t, beside):
+    """Rows of the seeds table: {cohesion_factor, seed_k..., mean, std_over_the_seeds, relative, beside...}."""
+    runs = t['runs']
+    seeds = sorted(set(runs['seed']))
+    rows = []
+    p = t['points']
+    for f, mean, std, n in zip(p['f'], p['ci_mean'], p['ci_std'], p['seeds']):
+        row = {'cohesion_factor': f}
+        for s in seeds:
+            ci = [c for fi, si, c in zip(runs['f'], runs['seed'], runs['ci']) if abs(fi - f) < 1e-9 and si == s]
+            row['seed_%d' % s] = _g(ci[0]) if ci else '—'
+        row['mean'] = '**{:.1f}**'.format(mean)
+        row['std_over_the_seeds'] = _g(std, 1)
+        row['relative'] = '{:.1f} %'.format(100.0 * std / mean) if mean else '—'
+        for title, other in beside:
+            m = _mean_at(other, f)
+            row[_key(title)] = _g(m, 1) if m is not None else '—'
+        rows.append(row)
+    columns = [{'key': 'cohesion_factor', 'title': 'f'}]
+    columns += [{'key': 'seed_%d' % s, 'title': 'seed %d' % s} for s in seeds]
+    columns += [{'key': 'mean', 'title': 'mean'}, {'key': 'std_over_the_seeds', 'title': 'std over the seeds'},
+                {'key': 'relative', 'title': 'relative'}]
+    columns += [{'key': _key(title), 'title': title} for title, _ in beside]
+    return columns, rows
+
+
+def table_rows(t):
+    d, mu = t['particle_diameter'], t['friction']
+    columns = [{'key': 'cone_index_psi', 'title': 'CI [psi]'}]
+    row = {'cone_index_psi': 'f ({:g} m, mu {:g}, {:g} m/s)'.format(
+        d, mu, t['provenance'].get('conditions', {}).get('cone_speed', float('nan')))}
+    for ci, f in t['table']:
+        title = '{:g}'.format(ci)
+        columns.append({'key': _key(title), 'title': title})
+        row[_key(title)] = _g(f)
+    return columns, [row]
+
+
+def write(root, table_path, machine, command=None, beside=(), conditions=None):
+    """Writes docs/data/cone-seeds-dD.yaml and cone-table-dD.yaml; returns their paths."""
+    t = _load(table_path)
+    prov = t['provenance']
+    d = '{:g}'.format(t['particle_diameter'])
+    rel = os.path.relpath(os.path.abspath(table_path), root)
+    base = {
+        'doc': 'cone-penetrometer.md',
+        'provenance': {
+            'commit': '{} (the table file\'s provenance)'.format(str(prov.get('commit', '?'))[:7]),
+            'machine': machine,
+            'date': str(prov.get('date', '?')),
+            'command': command or prov.get('command') or 'dm-calibrate --fidelity {} (see {})'.format(t['fidelity'], rel),
+            'recorded_in': '{} (runs, points, table); its runs under config/calibration/runs/{}'.format(
+                rel, t['fidelity']),
+        },
+    }
+    if conditions:
+        base['provenance']['conditions'] = conditions
+    out = []
+    for name, (columns, rows) in (('seeds', seeds_rows(t, beside)), ('table', table_rows(t))):
+        data = dict(table='cone/{}_d{}'.format(name, d), **base, columns=columns, rows=rows)
+        path = os.path.join(root, 'docs', 'data', 'cone-{}-d{}.yaml'.format(name, d))
+        with open(path, 'w') as f:
+            yaml.safe_dump(data, f, sort_keys=False, allow_unicode=True, width=110)
+        out.append(path)
+    return out
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(prog='dm-docs-cone', description=__doc__.split('\n')[0])
+    p.add_argument('table', help='a table dm-calibrate installed (config/calibration/cone_index_mu*_d*.yaml)')
+    p.add_argument('--machine', required=True, help='the machine the runs were made on')
+    p.add_argument('--command', default=None, help='the command that made the table (default: its provenance\'s)')
+    p.add_argument('--conditions', default=None, help='how the runs were made (one line)')
+    p.add_argument('--beside', action='append', default=[], metavar='TITLE=TABLE',
+                   help='another table whose mean CI at the same f gets a column TITLE')
+    p.add_argument('--root', default=None, help='the checkout (default: the working folder)')
+    a = p.parse_args(argv)
+    root = a.root or default_root()
+    try:
+        beside = []
+        for b in a.beside:
+            title, sep, path = b.rpartition('=')
+            if not sep:
+                raise DocsError('--beside {}: want TITLE=TABLE'.format(b))
+            beside.append((title, _load(path)))
+        for path in write(root, a.table, a.machine, a.command, beside, a.conditions):
+            print(os.path.relpath(path, root))
+    except DocsError as e:
+        print('dm-docs-cone: {}'.format(e), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
