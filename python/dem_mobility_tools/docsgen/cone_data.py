@@ -1,7 +1,9 @@
 """dm-docs-cone: writes the docs' data files of one cone index table (docs/data/cone-seeds-dD.yaml
-and cone-table-dD.yaml) from the table dm-calibrate installed, for dm-docs to render.
+and cone-table-dD.yaml) from the table dm-calibrate installed, for dm-docs to render; with
+--tables, the overview of every table installed (docs/data/cone-tables.yaml).
 
     dm-docs-cone config/calibration/cone_index_mu0.1_d0.06.yaml --machine "..." [--beside TABLE ...]
+    dm-docs-cone --tables config/calibration --machine "..."
 
 The seeds table has a row per f: every seed's CI, the mean, the std over the seeds and its
 relative size, and (--beside) the mean CI of other tables at the same f; the table has the
@@ -84,7 +86,7 @@ def table_rows(t):
     return columns, [row]
 
 
-def write(root, table_path, machine, command=None, beside=(), conditions=None):
+def write(root, table_path, machine, command=None, beside=(), conditions=None, soil_law=None):
     """Writes docs/data/cone-seeds-dD.yaml and cone-table-dD.yaml; returns their paths."""
     t = _load(table_path)
     prov = t['provenance']
@@ -103,6 +105,8 @@ def write(root, table_path, machine, command=None, beside=(), conditions=None):
     }
     if conditions:
         base['provenance']['conditions'] = conditions
+    if soil_law:
+        base['provenance']['soil_law'] = soil_law
     out = []
     for name, (columns, rows) in (('seeds', seeds_rows(t, beside)), ('table', table_rows(t))):
         data = dict(table='cone/{}_d{}'.format(name, d), **base, columns=columns, rows=rows)
@@ -113,25 +117,101 @@ def write(root, table_path, machine, command=None, beside=(), conditions=None):
     return out
 
 
+def _wall_times(root, t):
+    """min-max (mean) of the kept runs' wall times [min], '—' without kept runs."""
+    import glob
+    w = []
+    for path in glob.glob(os.path.join(root, 'config', 'calibration', 'runs', t['fidelity'], 'mu*_f*_s*.yaml')):
+        with open(path) as f:
+            r = yaml.safe_load(f)
+        if isinstance(r, dict) and r.get('friction') == t['friction'] and isinstance(r.get('wall_time'), (int, float)):
+            w.append(r['wall_time'] / 60.0)
+    if not w:
+        return '—'
+    return '{:.1f}–{:.1f} min (mean {:.1f}, {} runs)'.format(min(w), max(w), sum(w) / len(w), len(w))
+
+
+def write_overview(root, folder, machine, soil_law=None):
+    """docs/data/cone-tables.yaml: a row per table in `folder` (sorted by mu, then d)."""
+    import glob
+    tables = [(_load(p), p) for p in sorted(glob.glob(os.path.join(folder, 'cone_index_mu*_d*.yaml')))]
+    if not tables:
+        raise DocsError('{}: no cone_index_mu*_d*.yaml'.format(folder))
+    tables.sort(key=lambda tp: (tp[0]['friction'], tp[0]['particle_diameter']))
+    rows, dates, commits = [], set(), set()
+    for t, path in tables:
+        p, prov = t['points'], t['provenance']
+        dates.add(str(prov.get('date', '?')))
+        commits.add(str(prov.get('commit', '?'))[:7])
+        cond = prov.get('conditions', {})
+        rows.append({
+            'table': '`{}`'.format(os.path.basename(path)),
+            'level': t['fidelity'],
+            'd_m': t['particle_diameter'],
+            'mu': t['friction'],
+            'cone_m_s': cond.get('cone_speed', '—'),
+            'container_m': cond.get('container_diameter', '—'),
+            'f_points': ', '.join('{:g}'.format(f) for f in p['f']),
+            'seeds_per_f': ', '.join(str(n) for n in p['seeds']),
+            'ci_mean_std_per_f': ', '.join('{:.1f} ({:.1f})'.format(m, s) for m, s in zip(p['ci_mean'], p['ci_std'])),
+            'ci_range': '{:.1f}–{:.1f}'.format(t['table'][0][0], t['table'][-1][0]),
+            'band': '{:.1f} %'.format(100.0 * t['band']) if isinstance(t.get('band'), (int, float)) else '—',
+            'wall_time_per_run': _wall_times(root, t),
+        })
+    titles = (('table', 'table'), ('level', 'level'), ('d_m', 'd [m]'), ('mu', 'mu'), ('cone_m_s', 'cone [m/s]'),
+              ('container_m', 'container [m]'), ('f_points', 'f points'), ('seeds_per_f', 'seeds per f'),
+              ('ci_mean_std_per_f', 'CI mean (std) per f [psi]'), ('ci_range', 'CI range [psi]'), ('band', 'band'),
+              ('wall_time_per_run', 'wall time per run (1 thread)'))
+    data = {
+        'table': 'cone/tables',
+        'doc': 'cone-penetrometer.md',
+        'provenance': {
+            'commit': ', '.join(sorted(commits)) + ' (the tables\' provenance)',
+            'machine': machine,
+            'date': ', '.join(sorted(dates)),
+            'command': 'dm-calibrate --fidelity LEVEL ... --install config/calibration (each table\'s own command: '
+                       'its runs folder\'s sweep_options.yaml)',
+            'recorded_in': '{}/cone_index_mu*_d*.yaml; wall times from config/calibration/runs/LEVEL'.format(
+                os.path.relpath(os.path.abspath(folder), root)),
+        },
+        'columns': [{'key': k, 'title': v} for k, v in titles],
+        'rows': rows,
+    }
+    if soil_law:
+        data['provenance']['soil_law'] = soil_law
+    path = os.path.join(root, 'docs', 'data', 'cone-tables.yaml')
+    with open(path, 'w') as f:
+        yaml.safe_dump(data, f, sort_keys=False, allow_unicode=True, width=110)
+    return path
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(prog='dm-docs-cone', description=__doc__.split('\n')[0])
-    p.add_argument('table', help='a table dm-calibrate installed (config/calibration/cone_index_mu*_d*.yaml)')
+    p.add_argument('table', nargs='?', help='a table dm-calibrate installed (config/calibration/cone_index_mu*_d*.yaml)')
+    p.add_argument('--tables', metavar='FOLDER', default=None,
+                   help='write the overview of every table in FOLDER instead (docs/data/cone-tables.yaml)')
     p.add_argument('--machine', required=True, help='the machine the runs were made on')
     p.add_argument('--command', default=None, help='the command that made the table (default: its provenance\'s)')
     p.add_argument('--conditions', default=None, help='how the runs were made (one line)')
+    p.add_argument('--soil-law', default=None, help='the reading of the soil law the runs were made with (one line)')
     p.add_argument('--beside', action='append', default=[], metavar='TITLE=TABLE',
                    help='another table whose mean CI at the same f gets a column TITLE')
     p.add_argument('--root', default=None, help='the checkout (default: the working folder)')
     a = p.parse_args(argv)
     root = a.root or default_root()
     try:
+        if a.tables:
+            print(os.path.relpath(write_overview(root, a.tables, a.machine, a.soil_law), root))
+            return 0
+        if not a.table:
+            raise DocsError('name a table, or --tables FOLDER')
         beside = []
         for b in a.beside:
             title, sep, path = b.rpartition('=')
             if not sep:
                 raise DocsError('--beside {}: want TITLE=TABLE'.format(b))
             beside.append((title, _load(path)))
-        for path in write(root, a.table, a.machine, a.command, beside, a.conditions):
+        for path in write(root, a.table, a.machine, a.command, beside, a.conditions, a.soil_law):
             print(os.path.relpath(path, root))
     except DocsError as e:
         print('dm-docs-cone: {}'.format(e), file=sys.stderr)

@@ -3,7 +3,7 @@
 | plot (docs/)                                   | data                                                  |
 |------------------------------------------------|-------------------------------------------------------|
 | vehicle-on-soil-study.png                      | docs/vehicle-on-soil-study.yaml                       |
-| cone-ci-vs-f.png                               | docs/data/cone-sweep-0.4.yaml, the mu 0.05 table      |
+| cone-ci-vs-f-sizes.png                         | config/calibration/cone_index_mu0.1_d*.yaml           |
 | cone-ci-vs-f-d0.06.png, cone-ci-vs-f-d0.1.png  | config/calibration/cone_index_mu0.1_d*.yaml           |
 | single-wheel-{dp,torque,sinkage}-vs-slip.png   | docs/data/single-wheel-slip-sweep.yaml                |
 """
@@ -75,26 +75,31 @@ def cone_table(root, table_rel, png_name, title):
     return _finish(plt, fig, ax, title, os.path.join(root, 'docs', png_name))
 
 
-def cone_sweep_04(root):
-    """The 0.4 m/s sweep: CI against f for mu 0.1 and 0.05, the installed mu 0.05 table, the paper."""
-    d = _load(root, 'docs/data/cone-sweep-0.4.yaml')
-    rows = d['rows']
-    t005 = _load(root, 'config/calibration/cone_index_mu0.05_d0.06.yaml')
+def cone_sizes(root):
+    """Every installed mu 0.1 table on one axis: the mean CI per f with its std over the seeds and
+    the table, one colour per particle size, beside the paper's table 3."""
+    import glob
+    tables = []
+    for path in glob.glob(os.path.join(root, 'config', 'calibration', 'cone_index_mu0.1_d*.yaml')):
+        t = _load(root, os.path.relpath(path, root))
+        tables.append(t)
+    if not tables:
+        raise DocsError('config/calibration: no cone_index_mu0.1_d*.yaml')
+    tables.sort(key=lambda t: t['particle_diameter'])
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 5))
-    f = [r['cohesion_factor'] for r in rows]
-    ax.errorbar(f, [r['ci_mu01'] for r in rows], yerr=[r['std_mu01'] for r in rows], fmt='o', capsize=3,
-                label='runs, mu = 0.1 (window std)')
-    line = ax.plot(f, [r['ci_mu005'] for r in rows], 's', mfc='none', label='runs, mu = 0.05')[0]
-    ax.plot([r[1] for r in t005['table']], [r[0] for r in t005['table']], '-', color=line.get_color(),
-            label='installed table, mu = 0.05')
+    for t in tables:
+        p = t['points']
+        label = 'd = {:g} m ({})'.format(t['particle_diameter'], t['fidelity'])
+        line = ax.errorbar(p['f'], p['ci_mean'], yerr=p.get('ci_std') or None, fmt='o', capsize=3, label=label)
+        ax.plot([r[1] for r in t['table']], [r[0] for r in t['table']], '-', color=line[0].get_color(), lw=1)
     paper = _paper_table()
-    ax.plot([r[1] for r in paper], [r[0] for r in paper], 'k--', lw=1, label='paper, table 3 (mu = 0.1)')
+    ax.plot([r[1] for r in paper], [r[0] for r in paper], 'k--', lw=1, label='paper, table 3 (d = 0.03 m)')
     ax.set_xscale('log')
     ax.set_xlabel('cohesion factor f')
     ax.set_ylabel('cone index [psi]')
-    return _finish(plt, fig, ax, 'CI versus f, cone at 0.4 m/s, 0.06 m particles (paper fig. 14)',
-                   os.path.join(root, 'docs', 'cone-ci-vs-f.png'))
+    return _finish(plt, fig, ax, 'CI versus f at 0.1 m/s per particle size, mu 0.1 (paper table 3)',
+                   os.path.join(root, 'docs', 'cone-ci-vs-f-sizes.png'))
 
 
 _NUM = re.compile(r'^\s*(-?[0-9.]+)\s*(?:\((-?[0-9.]+)\))?')
@@ -166,7 +171,7 @@ def wheel_sweep(root):
 
 def draw_all(root):
     """Redraws every plot; returns their paths."""
-    out = [fidelity_study(root), cone_sweep_04(root),
+    out = [fidelity_study(root), cone_sizes(root),
            cone_table(root, 'config/calibration/cone_index_mu0.1_d0.06.yaml', 'cone-ci-vs-f-d0.06.png',
                       'CI versus f at 0.1 m/s, 0.06 m particles, mu 0.1'),
            cone_table(root, 'config/calibration/cone_index_mu0.1_d0.1.yaml', 'cone-ci-vs-f-d0.1.png',

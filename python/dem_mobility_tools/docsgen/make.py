@@ -129,8 +129,11 @@ def render_table(t):
     """The block's text (without the markers)."""
     prov = t['provenance']
     where = t['_file']
-    lines = ['*{}; {}.*'.format(prov['machine'], prov['date']) if t.get('show_command') is False
-             else '*{}; {}; `{}`.*'.format(prov['machine'], prov['date'], prov['command']), '']
+    head = ('{}; {}'.format(prov['machine'], prov['date']) if t.get('show_command') is False
+            else '{}; {}; `{}`'.format(prov['machine'], prov['date'], prov['command']))
+    if prov.get('soil_law'):  # which reading of the soil law the figures were measured with
+        head += '; soil law: {}'.format(prov['soil_law'])
+    lines = ['*{}.*'.format(head), '']
     if 'columns' in t:
         cols = [(_need(c, 'key', where + ': columns', str), _need(c, 'title', where + ': columns', str))
                 for c in t['columns']]
