@@ -44,6 +44,7 @@ catkin_install_python(PROGRAMS
   python/bin/dm-driveshaft-curves
   python/bin/dm-launch
   python/bin/dm-docs
+  python/bin/dm-docs-cone
   DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)
