@@ -322,18 +322,32 @@ TEST(Config, AKeyUnderAnOldNameIsRefusedNamingItsOneName) {
   EXPECT_DOUBLE_EQ(SingleWheelParams::Read(YamlReader::LoadWithOverrides(wheel, {"friction=0.2"})).bin.friction, 0.2);
 }
 
+// The f of a row of the 0.06 m table (its CI is one of the table's rows, so no interpolation is
+// involved): read from the table file as plain YAML, so that the test follows the table when it is
+// remade and checks only which strength the overrides pick.
+static double CoarseTableRowF(double ci) {
+  const YAML::Node table = YAML::LoadFile(DM_CONFIG_DIR "/calibration/cone_index_mu0.1_d0.06.yaml")["table"];
+  for (const auto& row : table) {
+    if (row[0].as<double>() == ci) return row[1].as<double>();
+  }
+  ADD_FAILURE() << "the 0.06 m table has no row at CI " << ci;
+  return std::nan("");
+}
+
 TEST(Config, AnOverriddenSoilStrengthTakesThePlaceOfTheFilesOther) {
   const std::string patch = DM_CONFIG_DIR "/terrains/soil_patch.yaml";  // cone_index: 100, coarse
   auto read = [&](const std::vector<std::string>& o) { return DemSoilParams::Read(YamlReader::LoadWithOverrides(patch, o)); };
-  // the file's CI 100 through the coarse table (the row [100, 7.5962])
+  const double f100 = CoarseTableRowF(100.0), f50 = CoarseTableRowF(50.0);
+  ASSERT_LT(f50, f100);
+  // the file's CI 100 through the coarse table's row at CI 100
   const DemSoilParams file = read({});
   EXPECT_DOUBLE_EQ(file.strength.requested_cone_index_psi, 100.0);
-  EXPECT_NEAR(file.strength.cohesion_factor, 7.5962, 1e-9);
-  // f 3 by an override: f 3, no requested CI; CI 50 by an override: the table's f (2.5953)
+  EXPECT_NEAR(file.strength.cohesion_factor, f100, 1e-9);
+  // f 3 by an override: f 3, no requested CI; CI 50 by an override: the table's f at CI 50
   const DemSoilParams f3 = read({"cohesion_factor=3"});
   EXPECT_DOUBLE_EQ(f3.strength.cohesion_factor, 3.0);
   EXPECT_TRUE(std::isnan(f3.strength.requested_cone_index_psi));
-  EXPECT_NEAR(read({"cone_index=50"}).strength.cohesion_factor, 2.5953, 1e-9);
+  EXPECT_NEAR(read({"cone_index=50"}).strength.cohesion_factor, f50, 1e-9);
   // both by overrides: refused
   try {
     read({"cohesion_factor=3", "cone_index=50"});
@@ -345,7 +359,7 @@ TEST(Config, AnOverriddenSoilStrengthTakesThePlaceOfTheFilesOther) {
   // the cone scene's file gives f 1: a cone index override takes its place (coarse table, CI 50)
   const std::string cone = DM_CONFIG_DIR "/scenes/cone_penetrometer.yaml";
   const ConeParams c = ConeParams::Read(YamlReader::LoadWithOverrides(cone, {"fidelity=coarse", "cone_index=50"}));
-  EXPECT_NEAR(c.strength.cohesion_factor, 2.5953, 1e-9);
+  EXPECT_NEAR(c.strength.cohesion_factor, f50, 1e-9);
   EXPECT_DOUBLE_EQ(ConeParams::Read(YamlReader::LoadWithOverrides(cone, {"fidelity=coarse"})).strength.cohesion_factor, 1.0);
   // both in the file: refused (a copy of the patch's file with f added, its paths made absolute)
   const std::string dir = ::testing::TempDir() + "/both_strengths";
