@@ -50,6 +50,7 @@ LAUNCHES = {
         'friction': ('friction', 'friction'),
         'seed': ('seed', 'seed'),
         'dem_threads': ('dem_threads', 'threads'),
+        'time_step': ('time_step', 'time_step'),
     },
 }
 

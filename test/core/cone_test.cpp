@@ -40,9 +40,9 @@ void ExpectRefused(const std::vector<std::string>& overrides, const std::vector<
 }
 
 TEST(ConeConfig, RefusesBadInputNamingTheKey) {
-  EXPECT_NO_THROW(Cone({"fidelity=coarse", "cohesion_factor=12"}));
-  ExpectRefused({"cohesion_factor=0.01"}, {"cohesion_factor", "outside the paper's range [0.05, 12]"});
-  ExpectRefused({"cohesion_factor=13"}, {"cohesion_factor", "outside"});
+  EXPECT_NO_THROW(Cone({"fidelity=coarse", "cohesion_factor=40"}));
+  ExpectRefused({"cohesion_factor=0.01"}, {"cohesion_factor", "outside the range a soil takes [0.05, 40]"});
+  ExpectRefused({"cohesion_factor=41"}, {"cohesion_factor", "outside"});
   // a cone wider than the test level's 1 m container (with the length its 30 degrees need)
   ExpectRefused({"fidelity=test", "cone.base_diameter=1.1", "cone.length=2.05263"},
                 {"cone.base_diameter", "wider than the container"});
@@ -55,6 +55,19 @@ TEST(ConeConfig, RefusesBadInputNamingTheKey) {
   ExpectRefused({"fidelity=coarse_cal", "levels.coarse_cal.approach_depth=0.8"},
                 {"levels.coarse_cal.approach_depth", "above the CI window"});
   ExpectRefused({"levels.coarse.approach_speed=0.4"}, {"levels.coarse.approach_depth", "missing"});
+  ExpectRefused({"time_step=0"}, {"time_step"});
+}
+
+// A run may take another step than its level's (a strong soil at the step the guard names): the
+// rest of the level stays as it is.
+TEST(ConeConfig, AStepGivenForTheRunTakesThePlaceOfTheLevels) {
+  const ConeParams level = Cone({"fidelity=coarse_cal"});
+  const ConeParams run = Cone({"fidelity=coarse_cal", "time_step=6e-5"});
+  EXPECT_DOUBLE_EQ(level.level.time_step, 8e-5);
+  EXPECT_DOUBLE_EQ(run.level.time_step, 6e-5);
+  EXPECT_EQ(run.level.name, "coarse_cal");
+  EXPECT_DOUBLE_EQ(run.level.particle_diameter, level.level.particle_diameter);
+  EXPECT_DOUBLE_EQ(run.level.cone_speed, level.level.cone_speed);
 }
 
 TEST(ConeConfig, ConeIndexTurnsIntoFThroughTheTable) {

@@ -319,7 +319,7 @@ TEST(SingleWheelConfig, RefusesBadInputNamingTheKey) {
   ExpectRefused({"fidelity=tiny", "levels.tiny.width=0.4"}, "levels.tiny.width");  // the tire is 0.254 m + 2 x 0.1 m
   ExpectRefused({"carriage.window=[0.8, 3.0]"}, "carriage.window");
   ExpectRefused({"carriage.start_x=0.3"}, "carriage.start_x");
-  ExpectRefused({"cohesion_factor=20"}, "cohesion_factor");
+  ExpectRefused({"cohesion_factor=41"}, "cohesion_factor");
   ExpectRefused({"wheel.load_mass=-3"}, "wheel.load_mass");
   ExpectRefused({"fidelity=huge"}, "fidelity");
   ExpectRefused({"wheel.sliip=0.1"}, "sliip");

@@ -31,8 +31,9 @@ import os, sys, time, yaml
 args = dict(a.split(':=', 1) for a in sys.argv[1:] if ':=' in a)
 f, mu, seed, bag = float(args['cohesion_factor']), float(args['friction']), int(args['seed']), args['bag']
 assert sys.argv[1] == '-p' and os.environ['ROS_MASTER_URI'].endswith(':' + sys.argv[2])
+dt = float(args.get('time_step') or 1.2e-4)   # (the tiny level's step unless one is given)
 with open(os.path.join(os.path.dirname(bag), 'calls'), 'a') as fh:
-    fh.write('%%g %%g %%s %%d\n' %% (f, mu, sys.argv[2], seed))
+    fh.write('%%g %%g %%s %%d %%g\n' %% (f, mu, sys.argv[2], seed, dt))
 print('[ INFO] terrain: progress: t = 0.1 s', flush=True)
 time.sleep(60 if f == 7 else 0.2)   # (f 7: a run still going when the sweep is interrupted)
 res = bag[:-4] + '.result.yaml'
@@ -43,7 +44,8 @@ if f > 15:
 ci = 30 + 20 * f + 2 * (seed - 1)   # seeds 1, 2, 3: mean 30 + 20 f + 2, sample std 2
 open(bag, 'w').write('bag')
 with open(res, 'w') as fh:
-    yaml.safe_dump({'fidelity': args['fidelity'], 'cohesion_factor': f, 'friction': mu, 'seed': seed, 'cone_index_psi': ci,
+    yaml.safe_dump({'fidelity': args['fidelity'], 'cohesion_factor': f, 'friction': mu, 'seed': seed, 'time_step': dt,
+                    'cone_index_psi': ci,
                     'window_samples': 4, 'wall_time': 1.5, 'error': '',
                     'history': {'t': [0.0, 0.5, 1.0], 'cone_index_psi': [0.0, ci / 2, ci]}}, fh)
 ''' % sys.executable
@@ -77,7 +79,7 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
             # the stand-in's CI is 30 + 20 f + 2 (mean over the seeds): the finest level reads 10 % below at f = 1
             yaml.safe_dump({'level': 'medium', 'friction': 0.1, 'particle_diameter': 0.05, 'source': 'a test',
                             'points': {'f': [1.0], 'ci': [52.0 / 1.1]}}, fh)
-        cls.seeded = cls.sweep('0.5,1,3', '--seeds', '1,2,3', '--seeds-at', '3=1,2,4', '--jobs', '1',
+        cls.seeded = cls.sweep('0.5,1,3', '--seeds', '1,2,3', '--seeds-at', '3=1,2,4', '--time-step-at', '3=6e-5', '--jobs', '1',
                                '--finest', cls.finest, '--install', cls.install, '--note', 'a note',
                                out=cls.seeds_out)
         with open(os.path.join(ROOT, 'config', 'scenes', 'cone_penetrometer.yaml')) as fh:
@@ -148,6 +150,10 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
             calls = sorted((float(c[0]), int(c[3])) for c in (line.split() for line in fh))
         cases = [(f, s) for f in (0.5, 1.0) for s in (1, 2, 3)] + [(3.0, s) for s in (1, 2, 4)]  # --seeds-at 3=1,2,4
         self.assertEqual(calls, cases)
+        # --time-step-at 3=6e-5: the runs at f 3 get that step, the others the level's
+        with open(os.path.join(self.seeds_out, 'runs', 'calls')) as fh:
+            steps = {float(c[0]): float(c[4]) for c in (line.split() for line in fh)}
+        self.assertEqual(steps, {0.5: 1.2e-4, 1.0: 1.2e-4, 3.0: 6e-5})
         name = 'cone_index_mu0.1_d%g.yaml' % self.tiny['particle_diameter']
         with open(os.path.join(self.seeds_out, name)) as fh:
             cal = yaml.safe_load(fh)
@@ -181,8 +187,9 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
             self.assertEqual(prov['soil_sha256'], hashlib.sha256(fh.read()).hexdigest())
         self.assertEqual(prov['scene_file'], 'config/scenes/cone_penetrometer.yaml')
         self.assertRegex(str(prov['date']), r'^\d{4}-\d\d-\d\d$')
-        for key in ('container_diameter', 'soil_depth', 'cone_speed', 'ci_window'):
+        for key in ('container_diameter', 'soil_depth', 'cone_speed', 'ci_window', 'time_step'):
             self.assertEqual(prov['conditions'][key], self.tiny[key], key)
+        self.assertEqual(prov['conditions']['time_step_at'], {3.0: 6e-5})
 
     def test_error_vs_finest_and_install(self):
         name = 'cone_index_mu0.1_d%g.yaml' % self.tiny['particle_diameter']
@@ -207,6 +214,8 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
                            (['--f', '1'], '--f needs two cohesion factors'),
                            (['--f', '1,2', '--finest', os.path.join(self.tmp, 'none.yaml')], 'No such file'),
                            (['--f', '1,2', '--seeds-at', '3=1,2'], '--seeds-at 3: not one of the --f values'),
+                           (['--f', '1,2', '--time-step-at', '3=6e-5'], '--time-step-at 3: not one of the --f values'),
+                           (['--f', '1,2', '--time-step-at', '2=0.01'], 'the time step must lie in (0, 1e-3] s'),
                            (['--f', '1,2', '--install', os.path.join(self.tmp, 'nowhere') + os.sep],
                             'nowhere/: no such directory')):
             out = os.path.join(self.tmp, 'refused_%d' % len(what))
@@ -270,6 +279,25 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         runs = {r['f']: r for r in s['runs']}
         self.assertTrue(runs[0.5]['ok'], runs)
         self.assertFalse(runs[7.0]['ok'], runs)
+
+    def test_a_resume_reruns_a_run_made_at_another_time_step(self):
+        out = os.path.join(self.tmp, 'steps')
+
+        def calls(*more):
+            r = self.sweep('0.5,1', '--resume', *more, out=out)
+            self.assertEqual(r.returncode, 0, r.stdout)
+            path = os.path.join(out, 'runs', 'calls')
+            made = []
+            if os.path.exists(path):
+                with open(path) as fh:
+                    made = sorted((float(c[0]), float(c[4])) for c in (line.split() for line in fh))
+                os.remove(path)
+            return made
+
+        self.assertEqual(calls('--time-step-at', '1=6e-5'), [(0.5, 1.2e-4), (1.0, 6e-5)])
+        self.assertEqual(calls('--time-step-at', '1=6e-5'), [])             # the same runs: kept
+        self.assertEqual(calls('--time-step-at', '1=5e-5'), [(1.0, 5e-5)])  # another step at f 1: rerun
+        self.assertEqual(calls(), [(1.0, 1.2e-4)])                          # the level's step again
 
     def test_a_resume_at_another_level_is_refused_naming_it(self):
         # (the runs' own results would let a kept run through the f, mu and seed checks: the

@@ -48,6 +48,18 @@ def seeds_at(text):
         raise argparse.ArgumentTypeError('expected F=SEED,SEED,..., got %r' % text)
 
 
+def time_step_at(text):
+    """'30=6e-5' -> (30.0, 6e-05)."""
+    try:
+        f, dt = text.split('=', 1)
+        f, dt = float(f), float(dt)
+    except ValueError:
+        raise argparse.ArgumentTypeError('expected F=TIME_STEP, got %r' % text)
+    if not 0.0 < dt <= 1e-3:
+        raise argparse.ArgumentTypeError('%r: the time step must lie in (0, 1e-3] s' % text)
+    return f, dt
+
+
 def case_name(mu, f, seed):
     return 'mu%g_f%g_s%d' % (mu, f, seed)
 
@@ -286,6 +298,9 @@ def parser():
                          'point wants at least 3)')
     ap.add_argument('--seeds-at', type=seeds_at, action='append', default=[], metavar='F=SEEDS',
                     help='other seeds at one f (e.g. 12=1,3,4 when seed 2 fails there); may be repeated')
+    ap.add_argument('--time-step-at', type=time_step_at, action='append', default=[], metavar='F=DT',
+                    help="the DEM time step [s] at one f instead of the level's (a soil whose adhesion ramp the "
+                         "level's step cannot follow: the step the guard names); may be repeated")
     ap.add_argument('--note', help="a note for the table's provenance (e.g. where runs kept by --resume were made)")
     ap.add_argument('--finest', help="YAML of the finest level's runs (level, friction, particle_diameter, "
                                      "points: {f: [...], ci: [...]}, source) to give the table its error against")
@@ -319,9 +334,10 @@ def check_args(a):
         sys.exit('dm-calibrate: --seeds must list distinct seeds >= 0')
     if not os.path.isfile(a.scene):
         sys.exit('dm-calibrate: no scene file %s' % a.scene)
-    stray = [f for f, _ in a.seeds_at if f not in a.f]
-    if stray:
-        sys.exit('dm-calibrate: --seeds-at %g: not one of the --f values' % stray[0])
+    for option, given in (('--seeds-at', a.seeds_at), ('--time-step-at', a.time_step_at)):
+        stray = [f for f, _ in given if f not in a.f]
+        if stray:
+            sys.exit('dm-calibrate: %s %g: not one of the --f values' % (option, stray[0]))
     if a.commit and not a.keep:
         sys.exit('dm-calibrate: --commit commits what --keep DIR writes: name the folder')
     if a.install and a.install.endswith(os.sep) and not os.path.isdir(a.install):
@@ -350,10 +366,14 @@ def make_sweep(a, conditions, scene_sha, soil_sha):
     except ValueError as e:
         sys.exit('dm-calibrate: %s' % e)
 
+    steps = dict(a.time_step_at)
+
     def command(case, run):
+        step = [('time_step', steps[case['f']])] if case['f'] in steps else []
         return scene_command('roslaunch', 'cone_penetrometer.launch',
                              [('fidelity', a.fidelity), ('cohesion_factor', float(case['f'])),
-                              ('friction', float(case['mu'])), ('seed', int(case['seed'])), ('dem_threads', a.dem_threads)],
+                              ('friction', float(case['mu'])), ('seed', int(case['seed'])), ('dem_threads', a.dem_threads)]
+                             + step,
                              scene=a.scene, port=run.port, bag=bag_path(a.out, case.name),
                              launch_args=[('cloud_rate', float(a.cloud_rate))])
 
@@ -364,10 +384,12 @@ def make_sweep(a, conditions, scene_sha, soil_sha):
         return 'CI %.1f psi' % float(run.result['cone_index_psi']) if run.ok else 'FAILED: ' + run.error
 
     def same_run(case, old):
-        """A kept run was made with the same level, f, mu and seed."""
+        """A kept run was made with the same level, f, mu, seed and time step."""
+        dt = steps.get(case['f'], conditions.get('time_step'))
         try:
             return (old.get('fidelity') == a.fidelity and abs(old.get('cohesion_factor', -1) - case['f']) < 1e-12
-                    and abs(old.get('friction', -1) - case['mu']) < 1e-12 and old.get('seed') == case['seed'])
+                    and abs(old.get('friction', -1) - case['mu']) < 1e-12 and old.get('seed') == case['seed']
+                    and (dt is None or abs(old.get('time_step', -1) - dt) <= 1e-9 * dt))
         except TypeError:
             return False
 
@@ -443,7 +465,8 @@ def write_table(a, mu, runs, finest_ref, diameter, prov):
             'scene_file': os.path.relpath(os.path.abspath(a.scene), root),
             'scene_sha256': scene_sha,
             'date': time.strftime('%Y-%m-%d'),
-            'conditions': conditions,
+            'conditions': dict(conditions, **({'time_step_at': {f: dt for f, dt in sorted(a.time_step_at)}}
+                                              if a.time_step_at else {})),
         },
         'error_vs_finest': err,
     }

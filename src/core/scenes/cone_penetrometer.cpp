@@ -54,6 +54,9 @@ ConeParams ConeParams::Read(const YamlReader& y) {
   p.soil.cohesion_factor = p.strength.cohesion_factor;
   p.soil.friction = p.friction;
   p.threads = ReadThreads(y);
+  // the level's step unless one is given here: a strong soil whose adhesion ramp the level's step
+  // cannot follow runs at the step the guard names, the rest of the level unchanged
+  if (y.Has("time_step")) p.level.time_step = y.DoubleIn("time_step", 1e-8, 1e-3);
   p.seed = static_cast<unsigned>(y.Int("seed", 1));
   p.sample_interval = y.DoubleIn("sample_interval", 1e-4, 1.0, 0.01);
   const YamlReader c = y.Child("container");

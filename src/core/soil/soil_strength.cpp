@@ -56,7 +56,7 @@ SoilStrength SoilStrength::Read(const YamlReader& y, double particle_diameter, d
   }
   if (!(s.cohesion_factor >= kMinCohesionFactor && s.cohesion_factor <= kMaxCohesionFactor))
     y.Fail(by_ci ? "cone_index" : "cohesion_factor",
-           "the cohesion factor f = " + detail::Concat(s.cohesion_factor) + " lies outside the paper's range [" +
+           "the cohesion factor f = " + detail::Concat(s.cohesion_factor) + " lies outside the range a soil takes [" +
                detail::Concat(kMinCohesionFactor) + ", " + detail::Concat(kMaxCohesionFactor) + "]");
   return s;
 }
