@@ -214,3 +214,12 @@ class ConeData(RepoCopy):
         with open(os.path.join(self.tmp, 'docs', 'cone-penetrometer.md')) as f:
             text = f.read()
         self.assertIn('| 4.0 | 100.00 | 90.00 | 110.00 | **100.0** | 10.0 | 10.0 % |', text)
+        # a table whose f 4 ran at a step of its own: the seeds table gives each f its step
+        table['provenance']['conditions'].update(time_step=8e-5, time_step_at={4.0: 6e-5})
+        with open(path, 'w') as f:
+            yaml.safe_dump(table, f)
+        seeds_path, _ = cone_data.write(self.tmp, path, 'a test machine', 'dm-calibrate ...')
+        with open(seeds_path) as f:
+            s = yaml.safe_load(f)
+        self.assertEqual([c['title'] for c in s['columns']][:3], ['f', 'dt [s]', 'seed 1'])
+        self.assertEqual([r['time_step'] for r in s['rows']], ['8e-05', '6e-05'])

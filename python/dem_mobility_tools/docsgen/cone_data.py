@@ -49,13 +49,18 @@ def _mean_at(table, f):
 
 
 def seeds_rows(t, beside):
-    """Rows of the seeds table: {cohesion_factor, seed_k..., mean, std_over_the_seeds, relative, beside...}."""
+    """Rows of the seeds table: {cohesion_factor, [time_step,] seed_k..., mean, std_over_the_seeds, relative,
+    beside...}; the time step per f when some f ran at a step of its own (conditions.time_step_at)."""
     runs = t['runs']
     seeds = sorted(set(runs['seed']))
     rows = []
     p = t['points']
+    cond = t['provenance'].get('conditions', {})
+    steps = {float(f): dt for f, dt in (cond.get('time_step_at') or {}).items()}
     for f, mean, std, n in zip(p['f'], p['ci_mean'], p['ci_std'], p['seeds']):
         row = {'cohesion_factor': f}
+        if steps:
+            row['time_step'] = '{:g}'.format(steps.get(float(f), cond.get('time_step')))
         for s in seeds:
             ci = [c for fi, si, c in zip(runs['f'], runs['seed'], runs['ci']) if abs(fi - f) < 1e-9 and si == s]
             row['seed_%d' % s] = _g(ci[0]) if ci else '—'
@@ -67,6 +72,8 @@ def seeds_rows(t, beside):
             row[_key(title)] = _g(m, 1) if m is not None else '—'
         rows.append(row)
     columns = [{'key': 'cohesion_factor', 'title': 'f'}]
+    if steps:
+        columns.append({'key': 'time_step', 'title': 'dt [s]'})
     columns += [{'key': 'seed_%d' % s, 'title': 'seed %d' % s} for s in seeds]
     columns += [{'key': 'mean', 'title': 'mean'}, {'key': 'std_over_the_seeds', 'title': 'std over the seeds'},
                 {'key': 'relative', 'title': 'relative'}]
