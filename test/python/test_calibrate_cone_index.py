@@ -307,5 +307,23 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         self.assertIn('--resume: %s holds runs made with --fidelity tiny, not test' % self.out, r.stdout)
 
 
+@unittest.skipUnless(HAVE_PLOTS, 'needs python3-numpy')
+class TableThroughTheMeans(unittest.TestCase):
+    def test_the_table_passes_through_every_mean_where_a_cubic_cannot(self):
+        from dem_mobility_tools.calibration.cone_index import PAPER_TABLE, fit
+        # means on the paper's CI values, bending as the measured curves do (steep, then flat)
+        means = [(0.1, 30.0), (0.5, 50.0), (2.0, 80.0), (4.0, 100.0), (9.0, 150.0), (20.0, 200.0), (24.0, 242.0)]
+        cubic, table, band, method, cubic_residual = fit(means, [c for c, _ in PAPER_TABLE])
+        rows = dict((c, f) for c, f in table)
+        for f, ci in means:
+            self.assertAlmostEqual(rows[ci], f, places=9)
+        self.assertEqual([c for c, _ in table], [30, 40, 50, 60, 70, 80, 100, 120, 150, 200, 242])
+        self.assertTrue(all(b[1] > a[1] for a, b in zip(table, table[1:])))   # f rises with CI
+        self.assertEqual(band, 0.0)             # every point on the table
+        self.assertIn('PCHIP', method)
+        self.assertEqual(len(cubic), 4)
+        self.assertGreater(cubic_residual, 0.02)  # the paper's cubic misses some mean by more than 2 %
+
+
 if __name__ == '__main__':
     unittest.main()

@@ -156,6 +156,7 @@ CiCalibration CiCalibration::Read(const YamlReader& y) {
   // the fit the sweep wrote beside the table (for people; scenes interpolate in the table)
   if (y.DoubleList("cubic").size() != 4) y.Fail("cubic", "must hold 4 coefficients (CI^3, CI^2, CI, 1)");
   c.band = y.DoubleIn("band", 0.0, 10.0, 0.0);
+  y.DoubleIn("cubic_residual", 0.0, 10.0, 0.0);  // how far the cubic misses the means (for people)
   y.String("method", "");
   ReadProvenance(y, &c);
   ReadPoints(y, &c);
