@@ -68,6 +68,15 @@ void ReadProvenance(const YamlReader& y, CiCalibration* c) {
     if (!cond.Has(key)) cond.Fail(key, "missing required key (the conditions the sweep was run at)");
   for (const std::string& key : cond.Keys()) {
     std::string v;
+    if (key == "time_step_at") {  // the f values run at a step of their own: {f: dt}
+      const YamlReader at = cond.Child(key);
+      for (const std::string& f : at.Keys()) {
+        v += (v.empty() ? "{" : ", ") + f + ": " + detail::Concat(at.DoubleIn(f, 1e-9, 1e-3));
+      }
+      at.Finish();
+      c->provenance.emplace_back("conditions." + key, v + "}");
+      continue;
+    }
     try {
       v = detail::Concat(cond.Double(key));
     } catch (const ConfigError&) {
@@ -191,7 +200,7 @@ CiCalibration CiCalibration::LoadFor(const std::string& given, double particle_d
       throw ConfigError(detail::Concat(path, ": particle_diameter: the table was made for particles of ",
                                        c.particle_diameter, " m, not ", particle_diameter,
                                        " m: CI(f) depends on the particle size; run the cone sweep at ",
-                                       particle_diameter, " m (scripts/calibrate_cone_index.py)"));
+                                       particle_diameter, " m (dm-calibrate --fidelity LEVEL)"));
     if (!SameFriction(c.friction, friction))
       throw ConfigError(detail::Concat(path, ": friction: the table was made for mu ", c.friction, ", not ",
                                        friction, " (particle_diameter ", c.particle_diameter, " m)"));
@@ -213,7 +222,7 @@ CiCalibration CiCalibration::LoadFor(const std::string& given, double particle_d
   }
   if (match.empty())
     throw ConfigError(path + ": particle_diameter: no calibration table for " + wanted() +
-                      "; run the cone sweep at that size (scripts/calibrate_cone_index.py). Tables here (particle_diameter, "
+                      "; run the cone sweep at that size (dm-calibrate --fidelity LEVEL). Tables here (particle_diameter, "
                       "friction): " + (available.empty() ? std::string("none") : available));
   if (match.size() > 1)
     throw ConfigError(path + ": particle_diameter: " + std::to_string(match.size()) + " tables hold for " + wanted() +

@@ -2,7 +2,7 @@
 // index (CI, psi) into the cohesion factor f of the soil, for one particle size and one
 // inter-particle friction. CI(f) depends on the particle size (docs/cone-penetrometer.md), so a
 // table holds for the particle diameter its cone sweep was run at, and a scene must pick the table
-// of its own particles (LoadFor). Written by scripts/calibrate_cone_index.py from a sweep of cone
+// of its own particles (LoadFor). Written by dm-calibrate (python/dem_mobility_tools/calibration) from a sweep of cone
 // penetrometer runs (several seeds per f); the soil scenes read it.
 #pragma once
 
