@@ -84,7 +84,9 @@ class Doe(unittest.TestCase):
     def test_the_plan_prints_its_cost_with_and_without_pruning(self):
         rc, out, se = doe('plan', '--level', 'tiny')
         self.assertEqual(rc, 0, se)
-        self.assertIn('left out', out)                 # the paper's CIs beyond the tiny table
+        # the paper's whole grid: every CI of table 3 lies inside the tiny table (20.4-269.2 psi)
+        self.assertIn('x 12 cone indices (30, 40, 50, 60, 70, 80, 100, 120, 150, 200, 242, 300), level tiny', out)
+        self.assertNotIn('left out', out)
         self.assertIn('every case run:', out)
         self.assertIn('with pruning:', out)
         # 2 grades x (CI 50, the road): the bound "if none ended early" worked out from the measured
@@ -111,7 +113,7 @@ class Doe(unittest.TestCase):
         self.assertEqual(rc, 0, se)
         self.assertIn('the grid stops at 45 deg', out)     # St. Helens' crater walls are steeper
         self.assertIn('5 grades (0, 11.25, 22.5, 33.75, 45)', out)
-        self.assertIn('left out', out)                     # generated CIs above the tiny table
+        self.assertIn('4 cone indices (30, 120, 210, 300)', out)   # inside the tiny table, and the road
         rc, _, err = doe('plan', '--grid', 'map', '--grid-size', '14', '--elevation', ST_HELENS)
         self.assertEqual(rc, 2)
         self.assertIn('--grid-size', err)
@@ -135,9 +137,9 @@ class Doe(unittest.TestCase):
         rc, _, err = doe('plan', '--grades', '0,50', '--cone-indices', '30')
         self.assertEqual(rc, 2)
         self.assertIn('steeper than the scenes take', err)
-        rc, _, err = doe('plan', '--level', 'tiny', '--grades', '0,12', '--cone-indices', '30,200')
+        rc, _, err = doe('plan', '--level', 'tiny', '--grades', '0,12', '--cone-indices', '30,280')
         self.assertEqual(rc, 2)
-        self.assertIn('cone index 200 psi: outside the tiny level', err)
+        self.assertIn('cone index 280 psi: outside the tiny level', err)
         self.assertIn('cone_index_mu0.1_d0.1.yaml', err)
 
     def test_a_run_where_ros_cannot_find_the_package_is_refused_before_anything_is_written(self):

@@ -20,7 +20,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 # a value of each parameter that every scene takes
 VALUES = {'grade_deg': 12.0, 'duration': 5.0, 'fidelity': 'tiny', 'cone_index': 100.0, 'cohesion_factor': 1.5,
           'dem_threads': 1, 'seed': 3, 'slip': 0.2, 'drive': 'slip', 'friction': 0.1, 'load_mass': 1000.0,
-          'speed': 1.0}
+          'speed': 1.0, 'time_step': 1e-4}
 
 
 def launch_args(launch):
