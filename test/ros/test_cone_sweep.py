@@ -23,7 +23,7 @@ class ConeSweep(unittest.TestCase):
         cls.out = tempfile.mkdtemp(prefix='dm_cone_sweep_')
         cls.proc = subprocess.run(
             [sys.executable, '-m', 'dem_mobility_tools.calibration.cone_index', '--fidelity', 'tiny',  # dm-calibrate
-             '--f', '0.5,8,20', '--mu', '0.1', '--jobs', '2', '--cloud-rate', '10', '--port', '11711',
+             '--f', '0.5,8,41', '--mu', '0.1', '--jobs', '2', '--cloud-rate', '10', '--port', '11711',
              '--out', cls.out], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
             timeout=900)
         print(cls.proc.stdout)
@@ -34,8 +34,8 @@ class ConeSweep(unittest.TestCase):
         with open(os.path.join(self.out, 'sweep.yaml')) as fh:
             sweep = yaml.safe_load(fh)
         runs = {r['f']: r for r in sweep['runs']}
-        self.assertFalse(runs[20.0]['ok'])
-        self.assertIn('cohesion_factor', runs[20.0]['error'])
+        self.assertFalse(runs[41.0]['ok'])   # f above the 40 a soil takes
+        self.assertIn('cohesion_factor', runs[41.0]['error'])
         self.assertTrue(runs[0.5]['ok'] and runs[8.0]['ok'])
         self.assertGreater(runs[8.0]['cone_index_psi'], runs[0.5]['cone_index_psi'])
 
