@@ -88,13 +88,14 @@ inline std::unique_ptr<DemSoilTerrain> PreparedPatch(double ci, double length = 
   return std::make_unique<DemSoilTerrain>(*t);
 }
 
-/// The mean height of the highest particle centre of each column (d along x, the band's width
-/// across) of the band |y - y0| < half_width, over the columns holding particles.
+/// The mean height of the highest particle centre of each d x d column of the band
+/// |y - y0| < half_width, over the columns holding particles (many small columns: the mean of their
+/// tops scatters far less than one column's top does).
 inline double TrackTop(const DemSystem& s, double y0, double half_width, double d) {
-  std::map<long, double> top;
+  std::map<std::pair<long, long>, double> top;
   s.ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
     if (std::abs(x.y() - y0) >= half_width) return;
-    const long c = std::lround(std::floor(x.x() / d));
+    const std::pair<long, long> c{std::lround(std::floor(x.x() / d)), std::lround(std::floor(x.y() / d))};
     auto it = top.find(c);
     if (it == top.end()) top[c] = x.z();
     else it->second = std::max(it->second, x.z());

