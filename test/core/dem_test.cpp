@@ -251,6 +251,49 @@ TEST(Dem, WallContactSpringsFollowTheirParticlesThroughABuild) {
   EXPECT_NEAR(s.wall(0).force.x(), 20 * weight * std::sin(theta), 1e-6 * weight);
 }
 
+// A 0.1 m particle pressed onto a floor tilted 15 deg (below the wall's friction angle, atan 0.5)
+// with 50 times its weight (about the lid's 33 kPa on its cross-section, the load of a consolidated
+// bed's contacts), started sliding down at 1 m/s, at the tiny levels' step (1.2e-4 s). Coulomb
+// friction stops it after v0^2 / (2 a), a = g' (mu cos - sin), and holds it. At this load the Coulomb
+// element's dashpot mu F / v_slip is 30 times too stiff for an explicit step: stepped explicitly,
+// it reversed the sliding every step, each reversal reset the anchor, and the particle never
+// stuck (AsperityFriction::CoulombDamping).
+TEST(Dem, APressedParticleStopsWhereCoulombSaysAndSticksAtACoarseStep) {
+  SoilParams p = Nominal();
+  p.plasticity = false;
+  p.cohesion = false;
+  p.diameter = 0.1;
+  const double theta = 15.0 * M_PI / 180.0, mu = 0.5, g = 50.0 * 9.81, v0 = 1.0, dt = 1.2e-4;
+  DemSystem s(p, DemSettings());
+  s.set_gravity(g * Vector3d(std::sin(theta), 0, -std::cos(theta)));
+  DemWall floor = MakeQuadWall("floor", {-0.5, -0.5, 0}, {2.0, 0, 0}, {0, 1.0, 0});
+  floor.friction = mu;
+  s.AddWall(std::move(floor));
+  // resting on the floor at the depth that carries the load (d0 plus the load over k_n)
+  const double f_n = p.Mass() * g * std::cos(theta);
+  const double depth = p.adhesion_depth * p.diameter + f_n / p.NormalStiffness();
+  const int id = s.AddParticle(Vector3d(0, 0, 0.5 * p.diameter - depth));
+  s.Finalize(dt);
+  ASSERT_GT(mu * f_n / p.slip_velocity * dt / p.Mass(), 20.0);  // the explicit dashpot's c dt / m
+  for (int i = 0; i < 2000; ++i) s.Step();  // settle on the floor, held by the spring
+  ASSERT_LT(s.velocity(id).norm(), 1e-4);
+  const Vector3d x0 = s.position(id);
+  s.mutable_velocity(id) = Vector3d(v0, 0, 0);
+  const double a = g * (mu * std::cos(theta) - std::sin(theta));
+  for (int i = 0; i < static_cast<int>(0.1 / dt); ++i) s.Step();  // 11 stopping times
+  EXPECT_LT(s.velocity(id).norm(), 1e-4);
+  // the stopping distance, within what the spring's change of load (mu F sliding, m g' sin at rest)
+  // and one step's travel leave open
+  const double travel = s.position(id).x() - x0.x();
+  const double spring = (mu * f_n - p.Mass() * g * std::sin(theta)) / p.TangentialStiffness();
+  EXPECT_NEAR(travel, v0 * v0 / (2.0 * a), spring + v0 * dt) << "stopping distance";
+  // and it stays: 0.5 s more moves it less than a thousandth of the stopping distance
+  const Vector3d x1 = s.position(id);
+  for (int i = 0; i < static_cast<int>(0.5 / dt); ++i) s.Step();
+  EXPECT_LT((s.position(id) - x1).norm(), 1e-3 * v0 * v0 / (2.0 * a));
+  EXPECT_LT(s.velocity(id).norm(), 1e-4);
+}
+
 // a few hundred particles poured into a box come to rest: slow (under 1e-3 m/s, with plasticity at
 // f = 0.05, 1 and 3 and without it), barely overlapping, the walls carrying the whole weight.
 DemSystem PourIntoABox(bool plasticity, double* vmax, double* overlap, double* carried_fraction, double f = 1.0) {

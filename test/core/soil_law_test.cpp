@@ -228,11 +228,14 @@ TEST(SoilLaw, StickBelowAndSlipAboveMuTimesTheRepulsion) {
   const Eigen::Vector3d n(0, 0, 1);
   const double f_rep = 10.0, mu = 0.1, k_t = 0.2857 * kKn, dt = 1e-4;
   TangentialHistory h;
-  const Eigen::Vector3d v(1e-4, 0, 0);  // a tenth of the slip velocity: the Coulomb element gives 0.1 mu F
+  const Eigen::Vector3d v(1e-4, 0, 0);  // a tenth of the slip velocity: the Coulomb element's dashpot
+  // the dashpot mu F / v_slip stepped backward for the mass it acts on (half the particle's, over
+  // four sticking contacts): c / (1 + c dt / m)
+  const double c = mu * f_rep / 1e-3, m = p.Mass() / 8.0, coulomb = c / (1.0 + c * dt / m) * v.x();
   Eigen::Vector3d f;
   for (int i = 0; i < 10; ++i) f = SoilContactLaw(p).Tangential(n, v, f_rep, dt, &h);
   // stick: anchor spring plus the Coulomb element, opposing the motion
-  const double stick = k_t * 10 * 1e-4 * dt + 0.1 * mu * f_rep;
+  const double stick = k_t * 10 * 1e-4 * dt + coulomb;
   ASSERT_LT(stick, mu * f_rep);
   EXPECT_NEAR(f.x(), -stick, 1e-9);
   EXPECT_NEAR(f.y(), 0.0, 1e-12);
@@ -241,9 +244,30 @@ TEST(SoilLaw, StickBelowAndSlipAboveMuTimesTheRepulsion) {
   EXPECT_NEAR(f.norm(), mu * f_rep, 1e-12);
   // stop: the spring keeps what it carried while sliding (mu F less the Coulomb element's share)
   f = SoilContactLaw(p).Tangential(n, Eigen::Vector3d::Zero(), f_rep, dt, &h);
-  EXPECT_NEAR(f.x(), -(mu * f_rep - 0.1 * mu * f_rep), 1e-9);
+  EXPECT_NEAR(f.x(), -(mu * f_rep - coulomb), 1e-9);
   // no repulsion (only adhesion): no friction
   EXPECT_EQ(SoilContactLaw(p).Tangential(n, v, 0.0, dt, &h).norm(), 0.0);
+}
+
+// The Coulomb element's dashpot is stepped backward: one step of a mass m sliding against it
+// (v' = v - dt c' v / m) is implicit Euler's v / (1 + c dt / m), so it never reverses the sliding
+// however stiff the dashpot is for the step; as dt -> 0 it is the paper's mu F / max(v_slip, |v|).
+TEST(SoilLaw, TheCoulombDashpotIsSteppedBackwardAndTendsToThePapersAsTheStepShrinks) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 1000; ++k) {
+    const double mu = 0.05 + u(rng), f = 1000.0 * u(rng), v_slip = 1e-3, speed = 2e-3 * u(rng);
+    const double m = 1e-3 + u(rng), dt = std::pow(10.0, -7.0 + 4.0 * u(rng)), v = -speed;
+    const double c = mu * f / std::max(v_slip, speed);
+    const double ce = -AsperityFriction::CoulombDamping(mu, f, v_slip, speed, dt / m);
+    const double stepped = v - dt * ce * v / m;
+    EXPECT_NEAR(stepped, v / (1.0 + c * dt / m), 1e-12 * speed) << "c dt / m = " << c * dt / m;
+    EXPECT_GE(stepped * v, 0.0);  // no reversal
+    EXPECT_LE(ce, c);
+    EXPECT_NEAR(ce, c, c * c * dt / m + 1e-12 * c);  // c - c' = c^2 dt / m / (1 + c dt / m)
+  }
+  // explicit (no mass given): the paper's element
+  EXPECT_DOUBLE_EQ(-AsperityFriction::CoulombDamping(0.1, 300.0, 1e-3, 5e-4, 0.0), 0.1 * 300.0 / 1e-3);
 }
 
 TEST(SoilLaw, BadSoilFileNamesTheFileAndKey) {

@@ -172,6 +172,7 @@ struct LawConstants {
   double D, D2, dt, k_n, c_n, d0, dp, inv_dp, inv_d0_dp, s_n;
   double mu, k_t, inv_k_t, v_slip, c_visc;
   bool cohesion;
+  double step_per_mass;  // dt / the Coulomb dashpot's mass (SoilContactLaw::inv_damped_mass)
 };
 
 // The sweep's arrays (what the scalar kernel reads through ps and lists).
@@ -236,7 +237,7 @@ template <bool kCohesion>
     sy += vty * c.dt;
     sz += vtz * c.dt;
     const double vt_norm = std::sqrt((vtx * vtx + vty * vty) + vtz * vtz);
-    const double cc = -c.mu * repulsion / std::max(c.v_slip, vt_norm);
+    const double cc = AsperityFriction::CoulombDamping(c.mu, repulsion, c.v_slip, vt_norm, c.step_per_mass);
     const double fcx = cc * vtx, fcy = cc * vty, fcz = cc * vtz;
     double ftx = -c.k_t * sx + fcx, fty = -c.k_t * sy + fcy, ftz = -c.k_t * sz + fcz;
     const double limit = c.mu * std::max(0.0, repulsion);
@@ -489,7 +490,7 @@ bool CpuHasAvx2() {
 LawConstants ConstantsOf(const SoilContactLaw& law, double diameter, double dt) {
   const AsperityFriction& fr = law.friction;
   return LawConstants{diameter, diameter * diameter, dt,     law.k_n,    law.c_n,   law.d0,    law.dp,      law.inv_dp,
-                      law.inv_d0_dp, law.s_n, fr.mu, fr.k_t, fr.inv_k_t, fr.v_slip, fr.c_visc, law.cohesion};
+                      law.inv_d0_dp, law.s_n, fr.mu, fr.k_t, fr.inv_k_t, fr.v_slip, fr.c_visc, law.cohesion, dt * law.inv_damped_mass};
 }
 
 void SweepVector(SlabFunction slab, const SoilContactLaw& law, double diameter, double dt, int threads,

@@ -24,14 +24,27 @@ struct AsperityFriction {
       : mu(mu_), k_t(k_t_), inv_k_t(k_t_ > 0.0 ? 1.0 / k_t_ : 0.0), v_slip(v_slip_), c_anchor(c_anchor_),
         c_visc(c_visc_) {}
 
+  /// The Coulomb element's damping coefficient (negative: it opposes vt) at sliding speed `speed`.
+  /// Below the slip speed the element is a dashpot of mu f_rep / v_slip, which an explicit step
+  /// resolves only for dt < m v_slip / (mu f_rep) (3e-5 s for a 0.1 m soil particle under 300 N);
+  /// beyond that it reverses the sliding every step, and each reversal resets the anchor, so the
+  /// spring never holds a sticking contact. `step_per_mass` > 0 (the step over the mass the
+  /// dashpot acts on) integrates it backward (implicit Euler): c / (1 + c dt / m), which never
+  /// reverses the sliding in one step and tends to c as dt -> 0. 0 keeps it explicit.
+  [[gnu::always_inline]] static double CoulombDamping(double mu, double f_rep, double v_slip, double speed,
+                                                      double step_per_mass) {
+    const double c = -mu * f_rep / std::max(v_slip, speed);
+    return c / (1.0 - c * step_per_mass);
+  }
+
   /// The tangential force on this body for a sliding velocity `vt` (in the tangent plane),
   /// repulsive normal force `f_rep` and spring elongation `*s` (this body's contact point less the
   /// anchor, in the tangent plane); on slip `*s` is set to where the anchor slid (and `*slipped`,
-  /// if given, to true).
+  /// if given, to true). `step_per_mass`: see CoulombDamping.
   template <bool kAnchorDamping = false>
   [[gnu::always_inline]] Eigen::Vector3d Force(const Eigen::Vector3d& vt, double f_rep, Eigen::Vector3d* s,
-                                               bool* slipped = nullptr) const {
-    const double c = -mu * f_rep / std::max(v_slip, vt.norm());
+                                               bool* slipped = nullptr, double step_per_mass = 0.0) const {
+    const double c = CoulombDamping(mu, f_rep, v_slip, vt.norm(), step_per_mass);
     const Eigen::Vector3d f_c = c * vt;
     Eigen::Vector3d f_t = -k_t * *s + f_c;
     if constexpr (kAnchorDamping) f_t -= c_anchor * vt;

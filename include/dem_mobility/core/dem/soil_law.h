@@ -67,9 +67,18 @@ struct TangentialHistory {
 /// The contact law of a pair (or a particle and a wall) with its constants worked out once: the
 /// solver's inner loop, and what the tests check against the formulas.
 struct SoilContactLaw {
+  /// The sticking contacts the Coulomb element's implicit step shares a particle's mass among:
+  /// about four, the coordination of a frictional packing at rest. Measured on the 0.1 m cone at
+  /// f 5 (1.2e-4 / 3e-5 s): a pair's half mass over 1, 4 and 12 contacts reads 242/254, 272/264
+  /// and 284/264 psi (the explicit dashpot 100/206, 295 at 3.75e-6 s); over 12, a poured bed at
+  /// f 3 still moves at 1.8e-3 m/s after 1 s (docs/soil-model.md, "Tangential force").
+  static constexpr double kDampedNeighbours = 4.0;
   double k_n, c_n, d0, dp, inv_dp, inv_d0_dp, s_n;
   AsperityFriction friction;  ///< eq. 13-14, the viscosity c_t outside the cap
   bool cohesion;
+  /// 1 / the mass the Coulomb element's dashpot acts on in one contact: half a particle's mass
+  /// (a pair's reduced mass) shared among kDampedNeighbours contacts (AsperityFriction::CoulombDamping).
+  double inv_damped_mass;
   explicit SoilContactLaw(const SoilParams& p)
       : k_n(p.NormalStiffness()),
         c_n(p.NormalDamping()),
@@ -79,7 +88,8 @@ struct SoilContactLaw {
         inv_d0_dp(d0 > dp ? 1.0 / (d0 - dp) : 0.0),
         s_n(p.separation_factor),
         friction(p.friction, p.TangentialStiffness(), p.slip_velocity, 0.0, p.viscosity),
-        cohesion(p.cohesion) {}
+        cohesion(p.cohesion),
+        inv_damped_mass(p.Mass() > 0.0 ? 2.0 * kDampedNeighbours / p.Mass() : 0.0) {}
 
   /// Normal force of a contact with effective penetration `d` (the geometric overlap less the
   /// plastic deformations of the two particles), penetration rate `d_dot` (> 0 approaching) and
@@ -103,12 +113,13 @@ struct SoilContactLaw {
   /// other's) and repulsive force `f_rep`, on this body: the anchor spring is kept in the current
   /// tangent plane (projected, as LAMMPS' history springs are; the length lost is second order in
   /// the turn per step) and stretched by vt dt; the anchor slides when the force exceeds mu f_rep.
+  /// The Coulomb element's dashpot is stepped implicitly (AsperityFriction::CoulombDamping).
   [[gnu::always_inline]] Eigen::Vector3d Tangential(const Eigen::Vector3d& n, const Eigen::Vector3d& vt, double f_rep,
                                                     double dt, TangentialHistory* h) const {
     Eigen::Vector3d s = h->spring;
     s -= s.dot(n) * n;
     s += vt * dt;
-    const Eigen::Vector3d f_t = friction.Force(vt, f_rep, &s);
+    const Eigen::Vector3d f_t = friction.Force(vt, f_rep, &s, nullptr, dt * inv_damped_mass);
     h->spring = s;
     return f_t;
   }
