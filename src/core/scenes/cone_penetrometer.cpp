@@ -186,8 +186,8 @@ double ConePenetrometer::penetration_force() const {
 void ConePenetrometer::Reference(double t, double* z, double* v) const {
   const ConeLevel& l = p_.level;
   const double s = t - t0_;
-  // at approach_speed over the start gap and down to approach_depth, then at cone_speed
-  const double d1 = l.approach_speed > 0.0 ? p_.start_gap + l.approach_depth : 0.0;
+  // at approach_speed from the start down to approach_depth, then at cone_speed
+  const double d1 = l.approach_speed > 0.0 ? (z0_ - surface_) + l.approach_depth : 0.0;
   const double t1 = l.approach_speed > 0.0 ? d1 / l.approach_speed : 0.0;
   if (s < t1) {
     *z = z0_ - l.approach_speed * s;
@@ -199,7 +199,15 @@ void ConePenetrometer::Reference(double t, double* z, double* v) const {
 }
 
 void ConePenetrometer::PlaceCone() {
-  z_tip_ = z0_ = surface_ + p_.start_gap;
+  // above the consolidated surface, or above a particle standing higher over the cone's base (one
+  // the lid lifted with it): the cone's walls jump to their start, and a particle they land in
+  // would trip the overlap watchdog
+  const double r = 0.5 * p_.base_diameter + 0.5 * p_.level.particle_diameter;
+  double top = surface_;
+  dem_->ForEachParticle([&](int, const Vector3d& x, const Vector3d&) {
+    if (x.x() * x.x() + x.y() * x.y() < r * r) top = std::max(top, x.z() + 0.5 * p_.level.particle_diameter);
+  });
+  z_tip_ = z0_ = top + p_.start_gap;
   v_tip_ = p_.level.approach_speed > 0.0 ? -p_.level.approach_speed : -p_.level.cone_speed;
   t0_ = dem_->time();
   // the integral starts at the weight, so the cone does not sag when it is let go
