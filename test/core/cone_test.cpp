@@ -315,11 +315,13 @@ TEST(ConePenetrometer, ConeIndexRisesWithFWithinTheCalibrationBand) {
   ASSERT_DOUBLE_EQ(level.level.particle_diameter, cal.particle_diameter);
   EXPECT_GE(cal.MinSeeds(), 3);  // every point of the table is a mean over seeds
   ASSERT_GE(cal.points.size(), 3u);
-  // two of the cohesion factors the sweep ran, the table's second and fifth (0.2 and 1.5: far
-  // enough apart that one run's rise stands clear of the window's scatter; the second and third,
-  // 0.2 and 0.5, rose 17.6 psi against a scatter of 9.6 psi each): docs/cone-penetrometer.md
-  ASSERT_GE(cal.points.size(), 5u);
-  const double fs[2] = {cal.points[1].f, cal.points[4].f};
+  // two of the cohesion factors the sweep ran, the table's second and fourth (0.2 and 1: far
+  // enough apart that one run's rise stands clear of the window's scatter, where the second and
+  // third, 0.2 and 0.5, rose 17.6 psi against a scatter of 9.6 psi each; and weak enough for the
+  // PID to hold the cone within 5 %, which at the fifth, 1.5, strays 5.3-6.7 %):
+  // docs/cone-penetrometer.md
+  ASSERT_GE(cal.points.size(), 4u);
+  const double fs[2] = {cal.points[1].f, cal.points[3].f};
   ASSERT_FALSE(cal.seeds.empty());
   const int seed = *std::max_element(cal.seeds.begin(), cal.seeds.end()) + 1;  // in none of the table's runs
   ConeResult r[2];
