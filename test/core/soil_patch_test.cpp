@@ -142,13 +142,13 @@ TEST(SoilPatch, OnAGradeLaysItsFirstCopyAgainstTheSlumpedFace) {
   const PatchStats& s = patch.stats();
   ASSERT_TRUE(s.following);
   ASSERT_GE(s.copies, 2);
-  // the case this test is for: the face stood back from the wall by half a diameter and more, a
-  // gap a copy laid at the wall would leave (0.95 d with eq. 16 read as releasing energy, over a
-  // diameter when the bed boiled)
+  // the case this test is for: the face stood back from the wall by 0.4 diameters and more, a gap
+  // a copy laid at the wall would leave (0.45 d with the Coulomb dashpot stepped backward, whose
+  // pressed contacts stick; 0.95 d when they did not, over a diameter when the bed boiled)
   std::printf("face set back %.3f m (%.2f d); checks:", s.face_setback, s.face_setback / d);
   for (const PatchCheck& c : s.log) std::printf(" %.3f (%.2f)", c.density_ratio, c.reemitted_fraction);
   std::printf("\n");
-  EXPECT_GT(s.face_setback, 0.5 * d);
+  EXPECT_GT(s.face_setback, 0.4 * d);
   // every check from the first seam on (re-emitted soil in the window) within 10 % of the bed, as
   // the checks on a level bed are (KeepsItsParticleCount...)
   int seam = 0;

@@ -137,10 +137,11 @@ TEST(VehicleOnSoil, StuckOnASteepGradeOfSoftSoilEndsTheRunWithZero) {
   EXPECT_TRUE(r.ended_early);
   EXPECT_LT(r.sim_time, 8.0);  // ended soon after the 5 s stall, not at 40 s
   EXPECT_LT(r.history.back().speed, 0.2);
-  // the wheels were driven (they spin: slip far above the rolling one)
+  // the wheels were driven (they spin: slip far above a rolling wheel's zero; 0.445 with
+  // the Coulomb dashpot stepped backward, whose soil grips better at CI 30, 0.5 and more before)
   double slip = 0.0;
   for (double s : r.steady.slip) slip += 0.25 * s;
-  EXPECT_GT(slip, 0.5);
+  EXPECT_GT(slip, 0.3);
 }
 
 TEST(VehicleOnSoil, MoreGradeGivesLessSpeedAndMoreConeIndexMore) {

@@ -81,8 +81,8 @@ class CheapCells(unittest.TestCase):
             for f in ('dt1.1_noguard', 'dt2_noguard'):
                 self.assertIn(cells[('road', f)]['verdict'], ('stable', 'refused during the run'))
             for scene in ('wheel', 'soil'):
-                self.assertEqual(cells[(scene, 'ci300')]['verdict'], 'refused before the run')
-                self.assertIn('cone_index', cells[(scene, 'ci300')]['detail'])
+                self.assertEqual(cells[(scene, 'ci400')]['verdict'], 'refused before the run')
+                self.assertIn('cone_index', cells[(scene, 'ci400')]['detail'])
                 self.assertEqual(cells[(scene, 'paper_f12_tiny_dt')]['verdict'], 'refused before the run')
                 self.assertIn('critical step', cells[(scene, 'paper_f12_tiny_dt')]['detail'])
             self.assertTrue(os.path.exists(os.path.join(out, 'matrix.md')))

@@ -16,7 +16,7 @@ vehicle on the soil patch (tiny level), each run on stiff and extreme cases thro
 The cells: time step at 0.5, 0.9, 1.1 and 2 x the critical step the guard reports (the vehicle's on
 the road, the soil's on soil; 1.1 and 2 also with the guard off, `time_step_guard: false`, to show
 what it prevents); contact (road) and particle (soil) stiffness x 10; the DOE's steepest grade (39
-deg) and a 20 deg side slope; CI 30 and CI 300 (and f 0.05 and 12 directly); the vehicle at 25 m/s
+deg) and a 20 deg side slope; CI 30 and CI 400 (outside the tiny table; and f 0.05 and 12 directly); the vehicle at 25 m/s
 entering the soil (started rolling at speed, full throttle; the rig's carriage at 25 m/s); a drop
 from 0.5 m; particles of the paper's size (3 cm) at f 12, at the level's step and at the paper's.
 
@@ -120,7 +120,7 @@ def cells(scene, crit, out):
                  ('stiff10_step', 'particle stiffness x 10, the level\'s step 8e-5 s (under its critical step)',
                   ['soil=' + stiff_soil(out), 'levels.tiny.time_step=8e-5'], True),
                  ('ci30', 'CI 30', ['cone_index=30', 'cohesion_factor=~'], True),
-                 ('ci300', 'CI 300', ['cone_index=300', 'cohesion_factor=~'], True),
+                 ('ci400', 'CI 400', ['cone_index=400', 'cohesion_factor=~'], True),
                  ('f0.05', 'f 0.05', ['cohesion_factor=0.05'], True),
                  ('f12', 'f 12', ['cohesion_factor=12'], True),
                  ('speed25', 'carriage at 25 m/s', ['wheel.speed=25'], True),
@@ -139,7 +139,7 @@ def cells(scene, crit, out):
                  ('side20', '20 deg side slope (grade 0; soil over the width)',
                   ['grade_deg=0', 'side_slope_deg=20', t + 'track_strip_width=0'], False),
                  ('ci30', 'CI 30', [t + 'cone_index=30'], False),
-                 ('ci300', 'CI 300', [t + 'cone_index=300'], True),
+                 ('ci400', 'CI 400', [t + 'cone_index=400'], True),
                  ('f0.05', 'f 0.05', [t + 'cone_index=~', t + 'cohesion_factor=0.05'], False),
                  ('f12', 'f 12', [t + 'cone_index=~', t + 'cohesion_factor=12'], False),
                  ('speed25', 'arriving at 25 m/s, full throttle (soil over the width)',
