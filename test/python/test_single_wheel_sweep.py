@@ -386,6 +386,39 @@ class SweepWithoutRos(unittest.TestCase):
             self.assertNotEqual(r.returncode, 0, r.stdout)
             self.assertIn('--resume: %s holds runs made with %s' % (self.out, what), r.stdout)
 
+    def test_kept_runs_take_a_resume_from_another_folder_past_them(self):
+        # --keep DIR: each finished run (ok or sunk; not a failed one) compacted into DIR as it ends,
+        # with the sweep's options; a resume into a new OUT (a fresh clone) reruns only the rest
+        keep = os.path.join(self.tmp, 'kept')
+        a, b = os.path.join(self.tmp, 'keep_a'), os.path.join(self.tmp, 'keep_b')
+        r = self.sweep('0.1,0.7', '--keep', keep, '--out', a)
+        self.assertEqual(r.returncode, 1, r.stdout)  # the 0.7 runs fail
+        self.assertEqual(sorted(os.listdir(keep)), ['ci100_slip0.1.yaml', 'ci100_towed.yaml', 'ci20_slip0.1.yaml',
+                                                    'ci20_towed.yaml', 'sweep_options.yaml'])
+        self.assertIn('kept   ci20_slip0.1   ' + os.path.join(keep, 'ci20_slip0.1.yaml'), r.stdout)
+        with open(os.path.join(keep, 'ci100_slip0.1.yaml')) as fh:
+            kept = yaml.safe_load(fh)
+        self.assertEqual(kept['status'], 'ok')
+        self.assertAlmostEqual(kept['dp_over_w'], 0.5 * 0.1 + 100 / 1000.0)  # the stand-in's
+        self.assertIn('kept_from_commit', kept)
+        with open(os.path.join(keep, 'sweep_options.yaml')) as fh:
+            self.assertNotIn('--scene', yaml.safe_load(fh))  # the scene by its hash only
+        r = self.sweep('0.1,0.7', '--keep', keep, '--resume', '--out', b)
+        self.assertEqual(r.returncode, 1, r.stdout)
+        with open(os.path.join(b, 'runs', 'calls')) as fh:
+            ran = sorted(bag_of(json.loads(line)) for line in fh)
+        self.assertEqual(ran, ['ci100_slip0.7.bag', 'ci20_slip0.7.bag'])
+        self.assertIn('6 runs (ci 20,100 x slip 0.1,0.7 + towed), level tiny, 2 to run', r.stdout)
+        # kept runs made with another seed are refused, naming the folder
+        r = self.sweep('0.1', '--keep', keep, '--resume', '--seed', '5', '--out', os.path.join(self.tmp, 'keep_c'))
+        self.assertNotEqual(r.returncode, 0, r.stdout)
+        self.assertIn('--resume: %s holds runs made with --seed None, not 5' % keep, r.stdout)
+
+    def test_commit_without_keep_is_refused(self):
+        r = self.sweep('0.1', '--commit', '--out', os.path.join(self.tmp, 'no_keep'))
+        self.assertNotEqual(r.returncode, 0, r.stdout)
+        self.assertIn('--commit commits what --keep DIR writes', r.stdout)
+
 
 def bag_of(call):
     """The bag's file name in a recorded roslaunch call."""

@@ -36,7 +36,8 @@ from .. import names, paths
 from .. import sweep as dm_sweep
 from ..paths import ROOT
 from ..runs import scene_command
-from ..sweep.args import floats, keep_options, ros_package, sha256
+from ..sweep import keep as dm_keep
+from ..sweep.args import floats, git_commit, keep_options, ros_package, sha256
 from ..terramechanics import wheel_numerics as wn
 from .plots import LABEL_PREFIX, plots, soil_label  # noqa: F401
 
@@ -386,6 +387,11 @@ def parser():
                     help='--runner core: ' + paths.RUNNER_HELP)
     ap.add_argument('--progress', choices=('auto', 'tqdm', 'plain'), default='auto')
     ap.add_argument('--out', default='results/single_wheel')
+    ap.add_argument('--keep', metavar='DIR',
+                    help="also write each finished run's result (ok or sunk), its histories decimated, into DIR "
+                         "(e.g. docs/data/single-wheel-runs/coarse_s1), where --resume takes it as done: a sweep "
+                         "that outlives its machine goes on from a fresh clone")
+    ap.add_argument('--commit', action='store_true', help='commit each file --keep writes, on its own, as its run ends')
     return ap
 
 
@@ -406,6 +412,8 @@ def main(argv=None):
         sys.exit('%s: slip %g lies outside [-1, 1)' % (PROG, bad[0]))
     if not os.path.isfile(a.scene):
         sys.exit('%s: no scene file %s' % (PROG, a.scene))
+    if a.commit and not a.keep:
+        sys.exit('%s: --commit commits what --keep DIR writes: name the folder' % PROG)
     if a.runner == 'roslaunch':
         package, why = ros_package()
         if why:
@@ -425,23 +433,40 @@ def main(argv=None):
     runs_dir = os.path.join(a.out, 'runs')
     os.makedirs(runs_dir, exist_ok=True)
 
+    commit = git_commit(ROOT)
+
+    def keep(o):
+        """A finished run's compact result into --keep (committed with --commit) as it ends."""
+        if not a.keep or not o.ok:
+            return
+        path, why = dm_keep.keep_run(o.result_file, a.keep, o.name, commit=a.commit, root=ROOT,
+                                     message='single wheel: run %s at %s (%s)' % (o.name, a.fidelity, describe(o)),
+                                     extra={'kept_from_commit': commit},
+                                     also=[os.path.join(a.keep, dm_keep.OPTIONS_FILE)])
+        sweep.line('           kept   %-14s %s' % (o.name, path if why is None else 'NOT KEPT: %s' % why))
+
     # the progress lines of a running run: the rig nodelet's 'progress: ...', dm_run_scene's '... s wall  ...'
     sweep = dm_sweep.Sweep(cases, lambda case, run: command(a, case, run), runs_dir, jobs=a.jobs, port=a.port, timeout=a.timeout, check=check,
                            outputs=lambda case: [bag_path(a.out, case.name)], describe=describe,
                            progress=a.progress, accept_status=('sunk',), poll=1.0, status_every=20.0,
-                           progress_marker='progress:' if a.runner == 'roslaunch' else ' s wall ')
+                           progress_marker='progress:' if a.runner == 'roslaunch' else ' s wall ', on_done=keep)
     if a.runner == 'core':
         print('runner: core (%s): a developer check, NOT the launch files users run; no bags' % a.dm_run_scene,
               flush=True)
     # what the runs depend on and their results do not all hold (the seed, and the scene's values
     # of mu, load and speed where not given): a resume with other options is refused
+    # (in --keep, which a resume from another checkout reads, the scene by its hash only)
+    options = {'scene_sha256': sha256(a.scene), '--fidelity': a.fidelity, '--seed': a.seed, '--mu': a.mu,
+               '--load': a.load, '--speed': a.speed, '--runner': a.runner}
     try:
-        keep_options(a.out, {'--scene': os.path.abspath(a.scene), 'scene_sha256': sha256(a.scene),
-                             '--fidelity': a.fidelity, '--seed': a.seed, '--mu': a.mu, '--load': a.load,
-                             '--speed': a.speed, '--runner': a.runner}, a.resume)
+        keep_options(a.out, dict(options, **{'--scene': os.path.abspath(a.scene)}), a.resume)
+        if a.keep:
+            keep_options(a.keep, options, a.resume)
     except ValueError as e:
         sys.exit('%s: %s' % (PROG, e))
     if a.resume:
+        if a.keep:
+            dm_keep.restore_kept(a.keep, runs_dir, [c.name for c in cases], sweep.outcome_file)
         try:
             sweep.resume(accept=same_run(a))
         except names.OldNameError as e:
