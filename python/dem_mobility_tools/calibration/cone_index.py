@@ -422,15 +422,10 @@ def make_sweep(a, conditions, scene_sha, soil_sha):
         sys.exit('dm-calibrate: %s' % e)
     commit = git_commit(ROOT)
 
-    def keep(o):
-        """A good run's compact result into --keep (committed with --commit) as it ends."""
-        if not a.keep or not o.ok:
-            return
-        path, why = dm_keep.keep_run(o.result_file, a.keep, o.name, commit=a.commit, root=ROOT,
-                                     message='calibration: run %s at %s (%s)' % (o.name, a.fidelity, describe(o)),
-                                     extra={'kept_from_commit': commit},
-                                     also=[os.path.join(a.keep, dm_keep.OPTIONS_FILE)])
-        sweep.line('           kept   %-14s %s' % (o.name, path if why is None else 'NOT KEPT: %s' % why))
+    # a good run's compact result into --keep (committed with --commit) as it ends
+    keep = dm_keep.keeper(a.keep, a.commit, ROOT,
+                          lambda o: 'calibration: run %s at %s (%s)' % (o.name, a.fidelity, describe(o)),
+                          {'kept_from_commit': commit}, lambda text: sweep.line(text))
 
     sweep = dm_sweep.Sweep(cases, command, os.path.join(a.out, 'runs'), jobs=a.jobs, port=a.port,
                            timeout=a.timeout, check=check, outputs=lambda case: [bag_path(a.out, case.name)],

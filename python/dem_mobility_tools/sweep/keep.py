@@ -82,6 +82,19 @@ def keep_run(result_file, keep_dir, name, commit=False, message=None, root=None,
     return path, None
 
 
+def keeper(keep_dir, commit, root, message, extra, line):
+    """A sweep's on_done callback: each good run (outcome.ok) compacted into keep_dir (committed with
+    `commit`) as it ends, with the sweep's options file; `message(outcome)` is the commit's message,
+    `line(text)` prints where the run went (or why it was not kept). No keep_dir: does nothing."""
+    def keep(o):
+        if not keep_dir or not o.ok:
+            return
+        path, why = keep_run(o.result_file, keep_dir, o.name, commit=commit, root=root, message=message(o),
+                             extra=extra, also=[os.path.join(keep_dir, OPTIONS_FILE)])
+        line('           kept   %-14s %s' % (o.name, path if why is None else 'NOT KEPT: %s' % why))
+    return keep
+
+
 def restore_kept(keep_dir, runs_dir, names, outcome_file):
     """For a resume: every kept run of `names` (keep_dir/<name>.yaml) that runs_dir does not hold a
     result of is copied there as its result, with an outcome file (outcome_file(name)) saying the

@@ -433,18 +433,10 @@ def main(argv=None):
     runs_dir = os.path.join(a.out, 'runs')
     os.makedirs(runs_dir, exist_ok=True)
 
-    commit = git_commit(ROOT)
-
-    def keep(o):
-        """A finished run's compact result into --keep (committed with --commit) as it ends."""
-        if not a.keep or not o.ok:
-            return
-        path, why = dm_keep.keep_run(o.result_file, a.keep, o.name, commit=a.commit, root=ROOT,
-                                     message='single wheel: run %s at %s (%s)' % (o.name, a.fidelity, describe(o)),
-                                     extra={'kept_from_commit': commit},
-                                     also=[os.path.join(a.keep, dm_keep.OPTIONS_FILE)])
-        sweep.line('           kept   %-14s %s' % (o.name, path if why is None else 'NOT KEPT: %s' % why))
-
+    # a finished run's compact result into --keep (committed with --commit) as it ends
+    keep = dm_keep.keeper(a.keep, a.commit, ROOT,
+                          lambda o: 'single wheel: run %s at %s (%s)' % (o.name, a.fidelity, describe(o)),
+                          {'kept_from_commit': git_commit(ROOT)}, lambda text: sweep.line(text))
     # the progress lines of a running run: the rig nodelet's 'progress: ...', dm_run_scene's '... s wall  ...'
     sweep = dm_sweep.Sweep(cases, lambda case, run: command(a, case, run), runs_dir, jobs=a.jobs, port=a.port, timeout=a.timeout, check=check,
                            outputs=lambda case: [bag_path(a.out, case.name)], describe=describe,
