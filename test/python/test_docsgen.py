@@ -223,3 +223,55 @@ class ConeData(RepoCopy):
             s = yaml.safe_load(f)
         self.assertEqual([c['title'] for c in s['columns']][:3], ['f', 'dt [s]', 'seed 1'])
         self.assertEqual([r['time_step'] for r in s['rows']], ['8e-05', '6e-05'])
+
+
+class WheelData(RepoCopy):
+    """dm-docs-wheel: the kept runs of a calibrated-wheel sweep become a row per CI and case, with
+    the references of wheel_numerics at the same CI, tire and load, and the seeds' mean and std."""
+
+    RUN = {'kind': 'single_wheel', 'status': 'ok', 'fidelity': 'coarse', 'particle_diameter': 0.06,
+           'cohesion_factor': 1.5, 'requested_cone_index_psi': 100, 'tire_radius': 0.485, 'tire_width': 0.254,
+           'load': 12066.3, 'load_mass': 1230, 'carriage_speed': 1, 'window': [0.8, 2.2], 'particles': 9653,
+           'wall_time': 120.0, 'kept_from_commit': '0123456789abc'}
+
+    def kept(self, name, seed, runs):
+        import yaml
+        folder = os.path.join(self.tmp, name)
+        os.makedirs(folder)
+        with open(os.path.join(folder, 'sweep_options.yaml'), 'w') as f:
+            yaml.safe_dump({'--seed': seed}, f)
+        for case, extra in runs.items():
+            with open(os.path.join(folder, case + '.yaml'), 'w') as f:
+                yaml.safe_dump(dict(self.RUN, **extra), f)
+        return folder
+
+    def test_rows_references_and_seeds(self):
+        import yaml
+        from dem_mobility_tools.docsgen import wheel_data
+        from dem_mobility_tools.terramechanics import wheel_numerics as wn
+        s1 = self.kept('s1', 1, {
+            'ci100_slip0.2': dict(drive='slip', slip_commanded=0.2, slip=0.2, dp_over_w=0.30, dp_over_w_std=0.05,
+                                  torque_over_wr=0.4, torque_over_wr_std=0.06, sinkage=0.05),
+            'ci100_towed': dict(drive='towed', slip=-0.05, dp_over_w=-0.15, dp_over_w_std=0.04, sinkage=0.05)})
+        s2 = self.kept('s2', 2, {'ci100_slip0.2': dict(drive='slip', slip_commanded=0.2, slip=0.2, dp_over_w=0.20)})
+        path = wheel_data.write(self.tmp, [s1, s2], 'a test machine', '2026-12-07')
+        with open(path) as f:
+            t = yaml.safe_load(f)
+        self.assertEqual(t['table'], 'single-wheel/calibrated')
+        self.assertEqual([r['case'] for r in t['rows']], ['towed (slip -0.050)', 'slip 0.2'])
+        towed, driven = t['rows']
+        self.assertEqual(driven['dp_w'], '0.300 (0.050)')
+        self.assertEqual(driven['dp_w_seeds'], '0.250 (0.071; 2 seeds)')  # mean 0.25, sample std 0.0707
+        self.assertEqual(towed['dp_w_seeds'], '—')  # one seed only
+        b, d, w = 0.254, 0.97, 12066.3
+        v = wn.vti(100, b, d, w, 0.0)
+        self.assertAlmostEqual(float(driven['vti_dp_w']), wn.vti_dp_over_w(0.2, v['nc'], b, d, v['ssp']), places=3)
+        self.assertAlmostEqual(float(driven['brixius_dp_w']), wn.brixius(0.2, 100, b, d, w)[2], places=3)
+        self.assertAlmostEqual(float(towed['vti_dp_w']), -v['mr_towed'], places=3)
+        self.assertIn('seed 1', t['provenance']['recorded_in'])
+        # an empty folder is refused, naming it
+        empty = os.path.join(self.tmp, 'empty')
+        os.makedirs(empty)
+        with self.assertRaises(make.DocsError) as e:
+            wheel_data.write(self.tmp, [empty], 'm', 'd')
+        self.assertIn(empty, str(e.exception))

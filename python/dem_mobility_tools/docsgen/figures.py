@@ -6,6 +6,7 @@
 | cone-ci-vs-f-sizes.png                         | config/calibration/cone_index_mu0.1_d*.yaml           |
 | cone-ci-vs-f-d0.06.png, cone-ci-vs-f-d0.1.png  | config/calibration/cone_index_mu0.1_d*.yaml           |
 | single-wheel-{dp,torque,sinkage}-vs-slip.png   | docs/data/single-wheel-slip-sweep.yaml                |
+| single-wheel-calibrated-dp-vs-slip.png         | docs/data/single-wheel-calibrated.yaml                |
 """
 import os
 import re
@@ -169,6 +170,44 @@ def wheel_sweep(root):
     return out
 
 
+def _cell(cell, rel, key):
+    """A number of the calibrated table's cell ('0.069 (0.040)' -> 0.069, 0.040); '—' -> None."""
+    if str(cell).strip() in ('—', '-', ''):
+        return None, None
+    return _num(cell, rel, key)
+
+
+def wheel_calibrated(root):
+    """DP/W against slip on each calibrated soil (coarse), beside VTI (rigid) and Brixius at its CI."""
+    rel = 'docs/data/single-wheel-calibrated.yaml'
+    soils = {}
+    for r in _load(root, rel)['rows']:
+        ci = str(r['ci']).split()[0]
+        if not str(r['case']).startswith('slip'):
+            continue
+        slip = float(str(r['case']).split()[1])
+        dp, sd = _cell(r['dp_w'], rel, 'dp_w')
+        soils.setdefault(ci, []).append((slip, dp, sd or 0.0, _cell(r['vti_dp_w'], rel, 'vti_dp_w')[0],
+                                         _cell(r['brixius_dp_w'], rel, 'brixius_dp_w')[0]))
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    for ci, pts in sorted(soils.items(), key=lambda kv: float(kv[0])):
+        pts.sort()
+        line = ax.errorbar([p[0] for p in pts], [p[1] for p in pts], yerr=[p[2] for p in pts], fmt='o-', capsize=3,
+                           label='DEM, CI %s (std of the samples)' % ci)
+        color = line[0].get_color()
+        vti = [p for p in pts if p[3] is not None]
+        ax.plot([p[0] for p in vti], [p[3] for p in vti], 's--', color=color, lw=1, mfc='none',
+                label='VTI rigid, CI %s' % ci)
+        ax.plot([p[0] for p in pts], [p[4] for p in pts], '^:', color=color, lw=1, mfc='none',
+                label='Brixius rigid, CI %s' % ci)
+    ax.axhline(0.0, color='0.6', lw=0.8)
+    ax.set_xlabel('slip')
+    ax.set_ylabel('DP/W')
+    return _finish(plt, fig, ax, 'The wheel on the calibrated soils (coarse, 0.06 m) against the empirical models',
+                   os.path.join(root, 'docs', 'single-wheel-calibrated-dp-vs-slip.png'))
+
+
 def draw_all(root):
     """Redraws every plot; returns their paths."""
     out = [fidelity_study(root), cone_sizes(root),
@@ -176,4 +215,4 @@ def draw_all(root):
                       'CI versus f at 0.1 m/s, 0.06 m particles, mu 0.1'),
            cone_table(root, 'config/calibration/cone_index_mu0.1_d0.1.yaml', 'cone-ci-vs-f-d0.1.png',
                       'CI versus f at 0.1 m/s, 0.1 m particles, mu 0.1')]
-    return out + wheel_sweep(root)
+    return out + wheel_sweep(root) + [wheel_calibrated(root)]
