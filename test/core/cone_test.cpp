@@ -260,6 +260,9 @@ TEST(CiCalibration, DescribeWritesTheTableIntoAResult) {
   EXPECT_DOUBLE_EQ(n["calibration_error_vs_finest"].as<double>(), 0.3);
   EXPECT_EQ(n["calibration_finest_level"].as<std::string>(), "medium");
   EXPECT_EQ(n["calibration_seeds"].as<int>(), 3);
+  // the scatter: the band, and the worst point over its seeds (stds 1, 2, 3 of means 30, 50, 100)
+  EXPECT_DOUBLE_EQ(n["calibration_band"].as<double>(), 0.02);
+  EXPECT_DOUBLE_EQ(n["calibration_points_relative_std_max"].as<double>(), 2.0 / 50.0);
   // no finer level run: a text that says why, never NaN
   std::string one = TableText(0.06, 0.1);
   one.replace(one.find("{level: medium, relative: 0.3, note: measured}"), 46,
@@ -268,6 +271,14 @@ TEST(CiCalibration, DescribeWritesTheTableIntoAResult) {
   CiCalibration::Read(YamlReader::FromString(one, "cal.yaml")).Describe(&r2);
   const std::string e = YAML::Load(r2.Text())["calibration_error_vs_finest"].as<std::string>();
   EXPECT_NE(e.find("only this level was run"), std::string::npos) << e;
+  // one seed per point: no spread over seeds, said in words
+  std::string single = TableText(0.06, 0.1);
+  single.replace(single.find("seeds: [3, 3, 3]"), 16, "seeds: [1, 1, 1]");
+  single.replace(single.find("ci_std: [1.0, 2.0, 3.0], "), 25, "");
+  ResultFile r3("scene.yaml", "wheel");
+  CiCalibration::Read(YamlReader::FromString(single, "cal.yaml")).Describe(&r3);
+  const std::string w = YAML::Load(r3.Text())["calibration_points_relative_std_max"].as<std::string>();
+  EXPECT_NE(w.find("no point of the table has more than one seed"), std::string::npos) << w;
 }
 
 // Every table installed in config/calibration says which particles it holds for, and one table

@@ -236,6 +236,15 @@ void CiCalibration::Describe(ResultFile* r) const {
   r->Set("calibration_particle_diameter", particle_diameter);
   r->Set("calibration_friction", friction);
   r->Set("calibration_seeds", MinSeeds());
+  // the table's scatter: its runs about the fit, and the worst point's spread over its seeds
+  r->Set("calibration_band", band);
+  double worst = -1.0;
+  for (const Point& q : points)
+    if (q.seeds > 1 && q.ci_mean > 0.0 && std::isfinite(q.ci_std)) worst = std::max(worst, q.ci_std / q.ci_mean);
+  if (worst >= 0.0)
+    r->Set("calibration_points_relative_std_max", worst);
+  else
+    r->Set("calibration_points_relative_std_max", "unknown: no point of the table has more than one seed");
   if (std::isfinite(error_vs_finest.relative))
     r->Set("calibration_error_vs_finest", error_vs_finest.relative);
   else

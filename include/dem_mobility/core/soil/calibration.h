@@ -56,8 +56,10 @@ struct CiCalibration {
 
   /// Writes into a result which table it used: calibration_table (path), calibration_level,
   /// calibration_particle_diameter, calibration_friction, calibration_seeds (fewest per point),
-  /// calibration_error_vs_finest (relative, or a text saying why it is not known) and
-  /// calibration_finest_level.
+  /// calibration_band (the runs' relative rms scatter about the fit),
+  /// calibration_points_relative_std_max (the largest std over the seeds of a point, relative to its
+  /// mean; a text when no point has two seeds), calibration_error_vs_finest (relative, or a text
+  /// saying why it is not known) and calibration_finest_level.
   void Describe(ResultFile* r) const;
 
   /// The fewest seeds behind a point of the table.
