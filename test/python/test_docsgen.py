@@ -269,6 +269,11 @@ class WheelData(RepoCopy):
         self.assertAlmostEqual(float(driven['brixius_dp_w']), wn.brixius(0.2, 100, b, d, w)[2], places=3)
         self.assertAlmostEqual(float(towed['vti_dp_w']), -v['mr_towed'], places=3)
         self.assertIn('seed 1', t['provenance']['recorded_in'])
+        # the CI at which VTI pulls the seeds' mean (0.25 at 20 % slip): VTI's pull there is 0.25
+        eq = float(driven['vti_ci'])
+        v = wn.vti(eq, b, d, w, 0.0)
+        self.assertAlmostEqual(wn.vti_dp_over_w(0.2, v['nc'], b, d, v['ssp']), 0.25, places=2)
+        self.assertEqual(towed['vti_ci'], '—')
         # an empty folder is refused, naming it
         empty = os.path.join(self.tmp, 'empty')
         os.makedirs(empty)

@@ -6,7 +6,8 @@ from the runs dm-wheel-sweep kept (--keep DIR, one folder per seed), for dm-docs
 A row per cone index and case (towed, then each slip): DP/W and T/(W r) of the first folder's run
 (the std of its 10 ms samples), where other folders hold the same case their seeds' mean and std,
 the sinkage, and at the same CI, tire and load the empirical references (nrmm-baseline.md section 4):
-VTI for the rigid tire (DP/W, GT/W), Brixius bias-ply rigid (NT/W, GT/W) and the band of every member.
+VTI for the rigid tire (DP/W, GT/W), Brixius bias-ply rigid (NT/W, GT/W) and the band of every member,
+and the cone index at which VTI would pull what the DEM wheel pulls (the seeds' mean where there are several).
 The references are empirical fits for pneumatic tires: the table reports the difference, nothing is
 tuned to them.
 """
@@ -26,7 +27,8 @@ TABLE = 'single-wheel/calibrated'
 COLUMNS = (('ci', 'CI [psi] (f)'), ('case', 'case'), ('dp_w', 'DP/W (std of the samples)'),
            ('dp_w_seeds', 'DP/W over the seeds (mean, std)'), ('vti_dp_w', 'VTI DP/W (rigid)'),
            ('brixius_dp_w', 'Brixius NT/W (rigid)'), ('band_dp_w', 'band DP/W'), ('t_w_r', 'T/(W r) (std)'),
-           ('vti_gt_w', 'VTI GT/W'), ('brixius_gt_w', 'Brixius GT/W'), ('sinkage_m', 'sinkage [m]'))
+           ('vti_gt_w', 'VTI GT/W'), ('brixius_gt_w', 'Brixius GT/W'), ('sinkage_m', 'sinkage [m]'),
+           ('vti_ci', 'CI at which VTI pulls the same [psi]'))
 
 
 def _load_runs(folder):
@@ -79,6 +81,20 @@ def references(ci, r, case):
     return (vti['dp_over_w'][0], bnt, (band['dp_lo'][0], band['dp_hi'][0]), vti['gt_over_w'][0], bgt)
 
 
+def vti_equivalent_ci(dp_w, s, b, d, w, lo=5.0, hi=2000.0):
+    """The cone index at which VTI (rigid tire) gives DP/W = dp_w at slip s (s > 0), by bisection
+    (VTI's pull rises with CI); None outside [lo, hi] psi."""
+    def pull(ci):
+        v = wn.vti(ci, b, d, w, 0.0)
+        return wn.vti_dp_over_w(s, v['nc'], b, d, v['ssp'])
+    if not s > 0 or not pull(lo) <= dp_w <= pull(hi):
+        return None
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if pull(mid) < dp_w else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
 def rows(folders):
     """The table's rows from the kept folders (the first: every case; the others: more seeds)."""
     first, _ = _load_runs(folders[0])
@@ -103,7 +119,12 @@ def rows(folders):
             'vti_gt_w': _f(vti_gt),
             'brixius_gt_w': _f(bx_gt),
             'sinkage_m': _f(r.get('sinkage')),
+            'vti_ci': '—',
         }
+        if case != 'towed':  # of the seeds' mean where there are several
+            eq = vti_equivalent_ci(statistics.mean(seeds), float(r['slip_commanded']), float(r['tire_width']),
+                                   2.0 * float(r['tire_radius']), float(r['load']))
+            row['vti_ci'] = '{:.0f}'.format(eq) if eq is not None else '—'
         out.append(row)
     return out
 
