@@ -123,7 +123,7 @@ class Figures(RepoCopy):
         from dem_mobility_tools.docsgen import figures
         with contextlib.redirect_stdout(io.StringIO()):
             drawn = figures.draw_all(self.tmp)
-        self.assertEqual(len(drawn), 7)
+        self.assertEqual(len(drawn), 8)
         docs = ''.join(open(os.path.join(ROOT, 'docs', f)).read()
                        for f in os.listdir(os.path.join(ROOT, 'docs')) if f.endswith('.md'))
         for path in drawn:

@@ -44,10 +44,10 @@ def fidelity_study(root):
     return png
 
 
-def _finish(plt, fig, ax, title, png):
+def _finish(plt, fig, ax, title, png, **legend):
     ax.set_title(title)
     ax.grid(alpha=0.3, which='both')
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, **legend)
     fig.tight_layout()
     fig.savefig(png, dpi=110)
     plt.close(fig)
@@ -190,7 +190,7 @@ def wheel_calibrated(root):
         soils.setdefault(ci, []).append((slip, dp, sd or 0.0, _cell(r['vti_dp_w'], rel, 'vti_dp_w')[0],
                                          _cell(r['brixius_dp_w'], rel, 'brixius_dp_w')[0]))
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 5))
+    fig, ax = plt.subplots(figsize=(10, 5))
     for ci, pts in sorted(soils.items(), key=lambda kv: float(kv[0])):
         pts.sort()
         line = ax.errorbar([p[0] for p in pts], [p[1] for p in pts], yerr=[p[2] for p in pts], fmt='o-', capsize=3,
@@ -205,7 +205,8 @@ def wheel_calibrated(root):
     ax.set_xlabel('slip')
     ax.set_ylabel('DP/W')
     return _finish(plt, fig, ax, 'The wheel on the calibrated soils (coarse, 0.06 m) against the empirical models',
-                   os.path.join(root, 'docs', 'single-wheel-calibrated-dp-vs-slip.png'))
+                   os.path.join(root, 'docs', 'single-wheel-calibrated-dp-vs-slip.png'),
+                   loc='center left', bbox_to_anchor=(1.02, 0.5))
 
 
 def draw_all(root):

@@ -142,7 +142,8 @@ def write(root, folders, machine, date, command=None, soil_law=None):
         'doc': 'single-wheel.md',
         'provenance': {
             'commit': '{} (the kept runs\' kept_from_commit)'.format(
-                ', '.join(sorted({str(r.get('kept_from_commit', '?'))[:7] for r in first.values()}))),
+                ', '.join(sorted({str(r.get('kept_from_commit', '?'))[:7] for f in folders
+                                  for r in _load_runs(f)[0].values()}))),
             'machine': machine,
             'date': date,
             'command': command or 'dm-wheel-sweep --fidelity {} --ci ... --keep {} (see its sweep_options.yaml)'.format(
