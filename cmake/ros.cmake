@@ -45,6 +45,7 @@ catkin_install_python(PROGRAMS
   python/bin/dm-launch
   python/bin/dm-docs
   python/bin/dm-docs-cone
+  python/bin/dm-docs-wheel
   DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)

@@ -15,7 +15,7 @@ import sys
 
 import yaml
 
-from .make import DocsError, default_root
+from .make import DocsError, default_root, write_data
 
 
 def _load(path):
@@ -117,10 +117,7 @@ def write(root, table_path, machine, command=None, beside=(), conditions=None, s
     out = []
     for name, (columns, rows) in (('seeds', seeds_rows(t, beside)), ('table', table_rows(t))):
         data = dict(table='cone/{}_d{}'.format(name, d), **base, columns=columns, rows=rows)
-        path = os.path.join(root, 'docs', 'data', 'cone-{}-d{}.yaml'.format(name, d))
-        with open(path, 'w') as f:
-            yaml.safe_dump(data, f, sort_keys=False, allow_unicode=True, width=110)
-        out.append(path)
+        out.append(write_data(root, 'cone-{}-d{}.yaml'.format(name, d), data))
     return out
 
 
@@ -184,12 +181,7 @@ def write_overview(root, folder, machine, soil_law=None):
         'columns': [{'key': k, 'title': v} for k, v in titles],
         'rows': rows,
     }
-    if soil_law:
-        data['provenance']['soil_law'] = soil_law
-    path = os.path.join(root, 'docs', 'data', 'cone-tables.yaml')
-    with open(path, 'w') as f:
-        yaml.safe_dump(data, f, sort_keys=False, allow_unicode=True, width=110)
-    return path
+    return write_data(root, 'cone-tables.yaml', data, soil_law)
 
 
 def main(argv=None):

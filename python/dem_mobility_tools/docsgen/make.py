@@ -36,6 +36,17 @@ def default_root():
     return os.path.abspath(os.path.join(os.path.dirname(__file__), '..', '..', '..'))
 
 
+def write_data(root, name, data, soil_law=None):
+    """Writes a data file docs/data/NAME (with the soil law its figures were measured with, if
+    given, in its provenance); returns its path."""
+    if soil_law:
+        data['provenance']['soil_law'] = soil_law
+    path = os.path.join(root, 'docs', 'data', name)
+    with open(path, 'w') as f:
+        yaml.safe_dump(data, f, sort_keys=False, allow_unicode=True, width=110)
+    return path
+
+
 def _need(d, key, where, kind=None):
     if not isinstance(d, dict) or key not in d:
         raise DocsError('{}: missing key {}'.format(where, key))

@@ -21,7 +21,7 @@ import sys
 import yaml
 
 from ..terramechanics import wheel_numerics as wn
-from .make import DocsError, default_root
+from .make import DocsError, default_root, write_data
 
 TABLE = 'single-wheel/calibrated'
 COLUMNS = (('ci', 'CI [psi] (f)'), ('case', 'case'), ('dp_w', 'DP/W (std of the samples)'),
@@ -162,12 +162,7 @@ def write(root, folders, machine, date, command=None, soil_law=None):
     }
     if options.get('--seed') is None:
         data['provenance']['conditions'] += '; the scene\'s seed'
-    if soil_law:
-        data['provenance']['soil_law'] = soil_law
-    path = os.path.join(root, 'docs', 'data', 'single-wheel-calibrated.yaml')
-    with open(path, 'w') as f:
-        yaml.safe_dump(data, f, sort_keys=False, allow_unicode=True, width=110)
-    return path
+    return write_data(root, 'single-wheel-calibrated.yaml', data, soil_law)
 
 
 def main(argv=None):
