@@ -95,10 +95,10 @@ def vti_equivalent_ci(dp_w, s, b, d, w, lo=5.0, hi=2000.0):
     return 0.5 * (lo + hi)
 
 
-def rows(folders):
-    """The table's rows from the kept folders (the first: every case; the others: more seeds)."""
-    first, _ = _load_runs(folders[0])
-    others = [_load_runs(f)[0] for f in folders[1:]]
+def rows(loaded):
+    """The table's rows from the kept folders' runs (_load_runs of each; the first: every case; the
+    others: more seeds)."""
+    first, others = loaded[0][0], [runs for runs, _ in loaded[1:]]
     out = []
     for (ci, case) in sorted(first, key=lambda k: (k[0], _case_key(k[1]))):
         r = first[(ci, case)]
@@ -131,19 +131,20 @@ def rows(folders):
 
 def write(root, folders, machine, date, command=None, soil_law=None):
     """Writes docs/data/single-wheel-calibrated.yaml; returns its path."""
-    first, options = _load_runs(folders[0])
+    loaded = [_load_runs(f) for f in folders]
+    first, options = loaded[0]
     any_run = next(iter(first.values()))
-    walls = [r['wall_time'] / 60.0 for f in folders for r in _load_runs(f)[0].values()
+    walls = [r['wall_time'] / 60.0 for runs, _ in loaded for r in runs.values()
              if isinstance(r.get('wall_time'), (int, float))]
-    seeds = [str(_load_runs(f)[1].get('--seed')) for f in folders]
+    seeds = [str(opts.get('--seed')) for _, opts in loaded]
     rel = [os.path.relpath(os.path.abspath(f), root) for f in folders]
     data = {
         'table': TABLE,
         'doc': 'single-wheel.md',
         'provenance': {
             'commit': '{} (the kept runs\' kept_from_commit)'.format(
-                ', '.join(sorted({str(r.get('kept_from_commit', '?'))[:7] for f in folders
-                                  for r in _load_runs(f)[0].values()}))),
+                ', '.join(sorted({str(r.get('kept_from_commit', '?'))[:7] for runs, _ in loaded
+                                  for r in runs.values()}))),
             'machine': machine,
             'date': date,
             'command': command or 'dm-wheel-sweep --fidelity {} --ci ... --keep {} (see its sweep_options.yaml)'.format(
@@ -158,7 +159,7 @@ def write(root, folders, machine, date, command=None, soil_law=None):
                               max(walls) if walls else math.nan),
         },
         'columns': [{'key': k, 'title': t} for k, t in COLUMNS],
-        'rows': rows(folders),
+        'rows': rows(loaded),
     }
     if options.get('--seed') is None:
         data['provenance']['conditions'] += '; the scene\'s seed'
