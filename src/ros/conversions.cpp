@@ -162,13 +162,14 @@ void Flatten(const XmlRpc::XmlRpcValue& v, const std::string& prefix, std::vecto
 
 MobilityRunParams LoadScene(const ros::NodeHandle& nh) { return MobilityRunParams::Read(LoadSceneFile(nh)); }
 
-YamlReader LoadSceneFile(const ros::NodeHandle& nh) {
+YamlReader LoadSceneFile(const ros::NodeHandle& nh, std::vector<std::string>* given) {
   std::string file;
   if (!nh.getParam("scene", file) || file.empty())
     throw ConfigError("parameter " + nh.resolveName("scene") + " (the scene file) is not set");
   std::vector<std::string> overrides;
   XmlRpc::XmlRpcValue o;
   if (nh.getParam("override", o)) Flatten(o, "", &overrides);
+  if (given) *given = overrides;
   // relative paths in overrides (vehicle:=, terrain:=) are the user's, relative to where they ran
   return YamlReader::LoadWithOverrides(file, overrides);
 }

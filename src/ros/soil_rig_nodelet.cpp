@@ -46,7 +46,8 @@ class SoilRigNodelet : public nodelet::Nodelet {
       Param(pnh, "result_file", &result_file_);
       Param(pnh, "frame_id", &frame_id_);
       Param(pnh, "wait_for_recorder", &wait_for_recorder_);
-      const YamlReader scene = LoadSceneFile(nh);
+      RigCheckpointOptions ck;
+      const YamlReader scene = LoadSceneFile(nh, &ck.overrides);
       scene_file_ = scene.file();
       kind = scene.String("scene");
       // the rig's result topic first, so that a rig that cannot start still reports why
@@ -57,7 +58,23 @@ class SoilRigNodelet : public nodelet::Nodelet {
       RateParam(pnh, "cloud_rate", &cloud_rate_);
       RateParam(pnh, "clock_rate", &clock_rate_);
       ResultFile::CheckWritable(result_file_, "parameter " + pnh.resolveName("result_file"));
-      rig_ = MakeSoilRig(scene);  // ConfigError naming the file and key for a scene that is no rig
+      Param(pnh, "checkpoint_file", &ck.file);
+      Param(pnh, "checkpoint_every", &ck.every);
+      Param(pnh, "restart_file", &ck.restart_file);
+      if (!(ck.every >= 1.0 && ck.every <= 1e7))
+        throw ConfigError("parameter " + pnh.resolveName("checkpoint_every") + ": " + std::to_string(ck.every) +
+                          " s: wall seconds between checkpoints are from 1 to 1e7");
+      if (!ck.file.empty()) {  // (its temporary file: the checkpoint itself may be the one restarted from)
+        ResultFile::CheckWritable(ck.file + ".writing", "parameter " + pnh.resolveName("checkpoint_file"));
+        std::remove((ck.file + ".writing").c_str());
+      }
+      checkpoints_ = std::make_unique<RigCheckpoints>(ck);
+      // ConfigError naming the file and key for a scene that is no rig, or naming the checkpoint
+      // for one that is not of this run
+      rig_ = checkpoints_->Start(scene);
+      if (checkpoints_->restarted())
+        NODELET_INFO("restarted from %s at t = %.3f s (step %ld), phase %s", ck.restart_file.c_str(),
+                     checkpoints_->identity().time, checkpoints_->identity().step, rig_->phase().c_str());
     } catch (const std::exception& e) {
       NODELET_FATAL("%s", e.what());
       if (topics_) topics_->PublishSetupError(e.what());
@@ -113,10 +130,12 @@ class SoilRigNodelet : public nodelet::Nodelet {
           break;
         }
         if (stop_ || !ros::ok()) {
+          checkpoints_->AfterStep(*rig_, /*now=*/true);
           rig_->Fail("interrupted: the run was stopped before its end");
           break;
         }
         rig_->Step();
+        checkpoints_->AfterStep(*rig_);
         const long k = s.step_count();
         if ((k & 1023) == 0 && std::chrono::steady_clock::now() > next_progress) {
           next_progress = std::chrono::steady_clock::now() + std::chrono::seconds(10);
@@ -141,7 +160,10 @@ class SoilRigNodelet : public nodelet::Nodelet {
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     try {
-      const ResultFile result = rig_->Report();
+      ResultFile result = rig_->Report();
+      const std::string kept = checkpoints_->Settle(*rig_, &result);
+      if (!kept.empty()) NODELET_WARN("%s", kept.c_str());
+      if (!checkpoints_->error().empty()) NODELET_ERROR("checkpoint failed: %s", checkpoints_->error().c_str());
       if (!result_file_.empty()) {
         try {
           result.Write(result_file_);
@@ -216,6 +238,7 @@ class SoilRigNodelet : public nodelet::Nodelet {
     tools_.publish(arr);
   }
 
+  std::unique_ptr<RigCheckpoints> checkpoints_;
   std::unique_ptr<SoilRig> rig_;
   std::unique_ptr<RigTopics> topics_;
   std::string scene_file_, frame_id_ = "map", result_file_;

@@ -8,9 +8,9 @@
 // key=value overrides a scene key (dotted for nested keys: driver.kp=4000, grade_deg=12).
 // Arguments of the form __name:=value (added by roslaunch) are ignored. Exit status: 0 done, 1 bad
 // input (the message names the file and key), 2 usage, 3 a numerical failure during the run (the
-// result file, written all the same, holds what was measured), 4 a mobility run stopped by SIGINT
-// or SIGTERM (it ends at the next step and its result and history are written, status
-// interrupted).
+// result file, written all the same, holds what was measured), 4 a mobility run or a soil rig
+// stopped by SIGINT or SIGTERM (it ends at the next step and its result and history are written,
+// status interrupted).
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -23,6 +23,7 @@
 #include "dem_mobility/core/common/result_file.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/mobility/mobility_run.h"
+#include "dem_mobility/core/scenes/soil_rig.h"
 #include "dem_mobility/tools/scene_runners.h"
 
 using namespace dem_mobility::core;
@@ -43,11 +44,13 @@ int Usage(std::ostream& os, int status) {
         "  --out FILE         writes the result (YAML) there; checked to be writable before the run\n"
         "  --history FILE     mobility runs: the speed history as CSV\n"
         "  --quiet            no progress lines\n"
-        "  --checkpoint FILE  mobility runs: keeps the whole run's state in FILE (written when the run begins\n"
-        "                     to step, every --checkpoint-every wall seconds, default 600, and on SIGINT or\n"
-        "                     SIGTERM; kept after an error or an interrupt, removed once the run has ended)\n"
-        "  --restart FILE     mobility runs: takes the run up from that checkpoint, bit for bit as if it had\n"
-        "                     never stopped; the same scene, overrides, input files and build are required\n"
+        "  --checkpoint FILE  mobility runs and soil rigs (cone_penetrometer, single_wheel): keeps the whole\n"
+        "                     run's state in FILE (written when the run begins to step, every\n"
+        "                     --checkpoint-every wall seconds, default 600, and on SIGINT or SIGTERM; kept\n"
+        "                     after an error or an interrupt, removed once the run has ended)\n"
+        "  --restart FILE     mobility runs and soil rigs: takes the run up from that checkpoint, bit for bit\n"
+        "                     as if it had never stopped; the same scene, overrides, input files and build\n"
+        "                     are required\n"
         "  --prepared-soil-cache DIR  soils prepared before by this build from the same files are read from\n"
         "                     DIR instead of prepared again, and a soil prepared here is kept there\n"
         "                     (default: the environment's DM_SOIL_CACHE; none when unset or empty)\n"
@@ -126,9 +129,10 @@ int main(int argc, char** argv) {
     }
     const std::string kind = FindSceneKind(reader).scene;
     if ((!options.checkpoint_file.empty() || !options.restart_file.empty()) && kind != "road_slope" &&
-        kind != "soil_slope")
+        kind != "soil_slope" && !IsSoilRigScene(kind))
       throw ConfigError(scene_file + ": scene " + kind +
-                        ": --checkpoint and --restart are for mobility runs (road_slope, soil_slope)");
+                        ": --checkpoint and --restart are for mobility runs (road_slope, soil_slope) and soil rigs "
+                        "(cone_penetrometer, single_wheel)");
     // the results must be writable before the run spends its time on them
     ResultFile::CheckWritable(out_file);
     ResultFile::CheckWritable(options.history_file);

@@ -18,6 +18,7 @@
 #include "dem_mobility/core/scenes/cone_penetrometer.h"
 #include "dem_mobility/core/scenes/dem_pour.h"
 #include "dem_mobility/core/scenes/single_wheel.h"
+#include "dem_mobility/core/scenes/soil_rig.h"
 #include "dem_mobility/core/scenes/uniaxial_compression.h"
 #include "dem_mobility/core/terrain/dem_soil.h"
 #include "dem_mobility/core/terrain/soil_patch.h"
@@ -141,7 +142,7 @@ StartedRun StartMobilityRun(const YamlReader& reader, const MobilityRunParams& p
     s.run = MobilityRun::FromCheckpoint(o.restart_file, p, o.scene_file.empty() ? reader.file() : o.scene_file,
                                         o.overrides, &s.resume, &s.restarted);
     std::printf("restarted from %s at t = %.3f s (step %ld; %.0f s of wall time before)\n", o.restart_file.c_str(),
-                s.restarted.driver_time, s.restarted.step, s.resume.r.wall_time);
+                s.restarted.time, s.restarted.step, s.resume.r.wall_time);
   } else {
     TerrainDescription described;  // (what the terrain is, once it has read its file)
     described.file = p.terrain_file;
@@ -203,7 +204,7 @@ void SettleCheckpoint(ResultFile* f, const MobilityRunResult& r, const SceneRunO
   const bool restart = !o.restart_file.empty();
   if (restart) {
     f->Set("restarted_from", o.restart_file);
-    f->Set("restarted_at", s.restarted.driver_time);
+    f->Set("restarted_at", s.restarted.time);
   }
   if (o.checkpoint_file.empty()) return;
   f->Set("checkpoints_written", console.written());
@@ -212,7 +213,7 @@ void SettleCheckpoint(ResultFile* f, const MobilityRunResult& r, const SceneRunO
   std::error_code ec;
   const bool same = restart && std::filesystem::equivalent(o.restart_file, o.checkpoint_file, ec);
   const bool holds = console.written() > 0 || same;
-  const double at = console.written() > 0 ? console.last_t() : s.restarted.driver_time;
+  const double at = console.written() > 0 ? console.last_t() : s.restarted.time;
   const std::string status = r.Status();
   if (status == "error" || status == "interrupted") {
     if (holds) {
@@ -269,31 +270,66 @@ ResultFile RunPourScene(const YamlReader& reader, const SceneRunOptions&) {
   return DemPourResultFile(r, p);
 }
 
+/// A soil rig of the scene, built afresh or taken up from a checkpoint, stepped to its end with its
+/// console lines and checkpoints; a stop from outside ends it interrupted, its checkpoint written
+/// first. Returns its result, with what it says of the checkpoints.
+ResultFile RunRig(const YamlReader& reader, const SceneRunOptions& o,
+                  const std::function<void(const SoilRig&)>& summary) {
+  RigCheckpointOptions c;
+  c.file = o.checkpoint_file;
+  c.every = o.checkpoint_every;
+  c.restart_file = o.restart_file;
+  c.scene_file = o.scene_file;
+  c.overrides = o.overrides;
+  RigCheckpoints checkpoints(c);
+  const std::unique_ptr<SoilRig> rig = checkpoints.Start(reader);
+  if (checkpoints.restarted())
+    std::printf("restarted from %s at t = %.3f s (step %ld), phase %s\n", o.restart_file.c_str(),
+                checkpoints.identity().time, checkpoints.identity().step, rig->phase().c_str());
+  std::fflush(stdout);
+  Ticker ticker(2.0);
+  try {
+    while (!rig->done()) {
+      if (o.stop && o.stop->load(std::memory_order_relaxed)) {
+        checkpoints.AfterStep(*rig, /*now=*/true);
+        rig->Fail("interrupted: the run was stopped before its end");
+        break;
+      }
+      rig->Step();
+      checkpoints.AfterStep(*rig);
+      if (!o.quiet && rig->dem().step_count() % 500 == 0 && ticker.Due()) {
+        std::printf("  %7.1f s wall  %s\n", ticker.Elapsed(), rig->StatusLine().c_str());
+        std::fflush(stdout);
+      }
+    }
+  } catch (const SimulationError& e) {
+    rig->Fail(e.what());
+  }
+  summary(*rig);
+  ResultFile f = rig->Report();
+  const std::string line = checkpoints.Settle(*rig, &f);
+  if (!line.empty()) std::printf("%s\n", line.c_str());
+  if (!checkpoints.error().empty()) std::printf("checkpoint failed: %s\n", checkpoints.error().c_str());
+  return f;
+}
+
 ResultFile RunConeScene(const YamlReader& reader, const SceneRunOptions& o) {
   const ConeParams p = ConeParams::Read(reader);
   std::printf("scene %s: level '%s', f %.4g, mu %.3g, %d particles of %.3g m in a %.3g m container, cone at %.3g m/s, "
               "dt %.3g s, %d thread(s)\n",
               p.file.c_str(), p.level.name.c_str(), p.strength.cohesion_factor, p.friction, p.ParticleCount(),
               p.level.particle_diameter, p.level.container_diameter, p.level.cone_speed, p.level.time_step, p.threads);
-  std::fflush(stdout);
-  ConePenetrometer rig(p);
-  Ticker ticker(2.0);
-  const ConeResult r = rig.Run(
-      [&](const ConePenetrometer& c) {
-        if (o.quiet || !ticker.Due()) return;
-        std::printf("  %7.1f s wall  %s\n", ticker.Elapsed(), c.StatusLine().c_str());
-        std::fflush(stdout);
-      },
-      500);
-  std::printf("prepared: surface %.3f m, bulk density %.1f -> %.1f kg/m^3, lid %.1f kPa held\n", r.surface_height,
-              r.density_poured, r.density_consolidated, r.lid_pressure_reached * 1e-3);
-  std::printf("cone_index: %.2f psi (std %.2f, trend %.1f psi/m over tip depths %.3g-%.3g m, %d samples); cone speed "
-              "%.4f-%.4f m/s\n",
-              r.cone_index_psi, r.cone_index_std_psi, r.cone_index_trend_psi_per_m, p.level.ci_from, p.level.ci_to, r.window_samples,
-              r.speed_min, r.speed_max);
-  std::printf("run: %ld steps, %.3f s simulated (%.3f s preparation) in %.1f s wall\n", r.steps, r.sim_time,
-              r.prep_time, r.wall_time);
-  return ConeResultFile(r, p);
+  return RunRig(reader, o, [&p](const SoilRig& rig) {
+    const ConeResult r = static_cast<const ConePenetrometer&>(rig).Result();
+    std::printf("prepared: surface %.3f m, bulk density %.1f -> %.1f kg/m^3, lid %.1f kPa held\n", r.surface_height,
+                r.density_poured, r.density_consolidated, r.lid_pressure_reached * 1e-3);
+    std::printf("cone_index: %.2f psi (std %.2f, trend %.1f psi/m over tip depths %.3g-%.3g m, %d samples); cone speed "
+                "%.4f-%.4f m/s\n",
+                r.cone_index_psi, r.cone_index_std_psi, r.cone_index_trend_psi_per_m, p.level.ci_from, p.level.ci_to,
+                r.window_samples, r.speed_min, r.speed_max);
+    std::printf("run: %ld steps, %.3f s simulated (%.3f s preparation) in %.1f s wall\n", r.steps, r.sim_time,
+                r.prep_time, r.wall_time);
+  });
 }
 
 ResultFile RunSingleWheelScene(const YamlReader& reader, const SceneRunOptions& o) {
@@ -306,28 +342,19 @@ ResultFile RunSingleWheelScene(const YamlReader& reader, const SceneRunOptions& 
               p.drive == SingleWheelParams::Drive::kSlip ? ("at slip " + std::to_string(p.slip)).c_str()
                                                           : SingleWheelParams::DriveName(p.drive),
               p.load_mass, p.speed);
-  std::fflush(stdout);
-  SingleWheelRig rig(p);
-  Ticker ticker(2.0);
-  RunSoilRig(
-      rig,
-      [&](const SoilRig& r) {
-        if (o.quiet || !ticker.Due()) return;
-        std::printf("  %7.1f s wall  %s\n", ticker.Elapsed(), r.StatusLine().c_str());
-        std::fflush(stdout);
-      },
-      500);
-  const SingleWheelRig::Window w = rig.Measured();
-  const double W = p.Weight(), R = p.tire.radius;
-  std::printf("prepared: surface %.3f m, lid %.1f kPa held\n", rig.bin().surface_height(),
-              rig.bin().preparation().lid_pressure_reached() * 1e-3);
-  std::printf("window %.2f-%.2f m (%d samples): DP/W %.4f (std %.4f), T/(Wr) %.4f (std %.4f), sinkage %.4f m "
-              "(std %.4f), slip %.4f\n",
-              p.window_from, p.window_to, w.samples, w.dp / W, w.dp_std / W, w.torque / (W * R),
-              w.torque_std / (W * R), w.sinkage, w.sinkage_std, w.slip);
-  std::printf("run: %ld steps, %.3f s simulated in %.1f s wall (%.1f s preparation)\n", rig.dem().step_count(),
-              rig.dem().time(), rig.wall_time(), rig.preparation_wall_time());
-  return rig.Report();
+  return RunRig(reader, o, [&p](const SoilRig& r) {
+    const auto& rig = static_cast<const SingleWheelRig&>(r);
+    const SingleWheelRig::Window w = rig.Measured();
+    const double W = p.Weight(), R = p.tire.radius;
+    std::printf("prepared: surface %.3f m, lid %.1f kPa held\n", rig.bin().surface_height(),
+                rig.bin().preparation().lid_pressure_reached() * 1e-3);
+    std::printf("window %.2f-%.2f m (%d samples): DP/W %.4f (std %.4f), T/(Wr) %.4f (std %.4f), sinkage %.4f m "
+                "(std %.4f), slip %.4f\n",
+                p.window_from, p.window_to, w.samples, w.dp / W, w.dp_std / W, w.torque / (W * R),
+                w.torque_std / (W * R), w.sinkage, w.sinkage_std, w.slip);
+    std::printf("run: %ld steps, %.3f s simulated in %.1f s wall (%.1f s preparation)\n", rig.dem().step_count(),
+                rig.dem().time(), rig.wall_time(), rig.preparation_wall_time());
+  });
 }
 
 ResultFile RunCompressionScene(const YamlReader& reader, const SceneRunOptions&) {

@@ -558,5 +558,33 @@ TEST(Config, RunnerStoppedWithACheckpointGoesOnFromItBitForBit) {
   EXPECT_NE(other.Err().find("overrides"), std::string::npos) << other.Err();
 }
 
+TEST(Config, RunnerStoppedRigGoesOnFromItsCheckpointToTheSameConeIndex) {
+  // the tiny cone (some 3 s) sent SIGTERM after 1 s with --checkpoint, then taken up with
+  // --restart: the cone index of the run that never stopped, to the last digit (the rigs' own
+  // test, rig_checkpoint_test, takes them up from each phase)
+  const fs::path dir = fs::temp_directory_path() / "dm_runner_rig_checkpoint";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string ckpt = (dir / "cone.ckpt").string(), args = "fidelity=tiny cohesion_factor=2 threads=1";
+  const RunnerRun whole("dm_runner_rig_whole", "", "cone_penetrometer.yaml", args);
+  ASSERT_EQ(whole.rc, 0) << whole.Err();
+  const RunnerRun stopped("dm_runner_rig_stopped", "timeout --preserve-status -s TERM 1", "cone_penetrometer.yaml",
+                          args + " --checkpoint " + ckpt);
+  ASSERT_TRUE(WIFEXITED(stopped.rc));
+  ASSERT_EQ(WEXITSTATUS(stopped.rc), 4) << stopped.Err();
+  const YAML::Node s = YAML::LoadFile(stopped.result);
+  EXPECT_EQ(s["status"].as<std::string>(), "interrupted");
+  EXPECT_EQ(s["checkpoint"].as<std::string>(), ckpt);
+  ASSERT_TRUE(fs::exists(ckpt));
+  const RunnerRun rest("dm_runner_rig_rest", "", "cone_penetrometer.yaml", args + " --restart " + ckpt + " --checkpoint " + ckpt);
+  ASSERT_EQ(rest.rc, 0) << rest.Err();
+  const YAML::Node a = YAML::LoadFile(whole.result), c = YAML::LoadFile(rest.result);
+  EXPECT_EQ(c["restarted_at"].as<double>(), s["checkpoint_at"].as<double>());
+  for (const char* key : {"cone_index_psi", "cone_index_std_psi", "steps", "simulated_time", "surface_height"})
+    EXPECT_EQ(c[key].as<std::string>(), a[key].as<std::string>()) << key;
+  EXPECT_FALSE(fs::exists(ckpt));  // the run ended: its result is what remains
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace dem_mobility::core

@@ -32,17 +32,29 @@ args = dict(a.split(':=', 1) for a in sys.argv[1:] if ':=' in a)
 f, mu, seed, bag = float(args['cohesion_factor']), float(args['friction']), int(args['seed']), args['bag']
 assert sys.argv[1] == '-p' and os.environ['ROS_MASTER_URI'].endswith(':' + sys.argv[2])
 dt = float(args.get('time_step') or 1.2e-4)   # (the tiny level's step unless one is given)
+ck, restart = args.get('checkpoint', ''), args.get('restart', '')
 with open(os.path.join(os.path.dirname(bag), 'calls'), 'a') as fh:
-    fh.write('%%g %%g %%s %%d %%g\n' %% (f, mu, sys.argv[2], seed, dt))
-print('[ INFO] terrain: progress: t = 0.1 s', flush=True)
-time.sleep(60 if f == 7 else 0.2)   # (f 7: a run still going when the sweep is interrupted)
+    fh.write('%%g %%g %%s %%d %%g %%s\n' %% (f, mu, sys.argv[2], seed, dt, restart or '-'))
 res = bag[:-4] + '.result.yaml'
+# as the rig nodelet: a checkpoint it cannot take up fails the run naming it; one of this run is
+# taken up; the run's checkpoint is written as it begins, its bag as it goes
+if restart and open(restart).read().startswith('refuse'):
+    with open(res, 'w') as fh:
+        yaml.safe_dump({'status': 'error', 'error': '%%s: checkpoint of the run of x: it was written by another '
+                                                    'build' %% restart}, fh)
+    sys.exit(1)
+if ck:
+    open(ck, 'w').write('the state of %%s' %% bag)
+open(bag, 'w').write('bag from %%s' %% ('the restart' if restart else 'the start'))
+print('[ INFO] terrain: progress: t = 0.1 s', flush=True)
+time.sleep(60 if f == 7 and not restart else 0.2)   # (f 7: a run still going when the sweep is interrupted)
 if f > 15:
     with open(res, 'w') as fh:
         yaml.safe_dump({'status': 'error', 'error': 'parameter cohesion_factor: %%g is out of range' %% f}, fh)
     sys.exit(1)
 ci = 30 + 20 * f + 2 * (seed - 1)   # seeds 1, 2, 3: mean 30 + 20 f + 2, sample std 2
-open(bag, 'w').write('bag')
+if ck:
+    os.remove(ck)   # (a run that ended: its result is what remains)
 with open(res, 'w') as fh:
     yaml.safe_dump({'fidelity': args['fidelity'], 'cohesion_factor': f, 'friction': mu, 'seed': seed, 'time_step': dt,
                     'cone_index_psi': ci,
@@ -279,6 +291,63 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         runs = {r['f']: r for r in s['runs']}
         self.assertTrue(runs[0.5]['ok'], runs)
         self.assertFalse(runs[7.0]['ok'], runs)
+
+    def test_a_resume_takes_a_stopped_run_up_from_its_checkpoint_and_runs_one_refused_afresh(self):
+        import signal
+        import time
+        out = os.path.join(self.tmp, 'taken_up')
+        runs, cks = os.path.join(out, 'runs'), os.path.join(out, 'checkpoints')
+        p = subprocess.Popen(
+            [sys.executable, '-m', 'dem_mobility_tools.calibration.cone_index', '--fidelity', 'tiny',
+             '--f', '0.5,7', '--mu', '0.1', '--jobs', '2', '--port', '11741', '--out', out],
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, env=self.env)
+        done = os.path.join(runs, 'mu0.1_f0.5_s1.result.yaml')
+        t0 = time.time()
+        while not (os.path.exists(done) and os.path.getsize(done) > 0) and time.time() - t0 < 60:
+            time.sleep(0.2)
+        time.sleep(1.5)
+        p.send_signal(signal.SIGTERM)
+        text = p.communicate(timeout=60)[0]
+        self.assertNotEqual(p.returncode, 0, text)
+        ck = os.path.join(cks, 'mu0.1_f7_s1.ckpt')
+        self.assertTrue(os.path.isfile(ck), text)                     # the stopped run's checkpoint
+        self.assertFalse(os.path.exists(os.path.join(cks, 'mu0.1_f0.5_s1.ckpt')), text)  # (ended: removed)
+        os.remove(os.path.join(runs, 'calls'))
+
+        def calls():
+            with open(os.path.join(runs, 'calls')) as fh:
+                made = {float(c[0]): c[5] for c in (line.split() for line in fh)}
+            os.remove(os.path.join(runs, 'calls'))
+            return made
+
+        # taken up from it: the bag of the part before is kept beside the new part's
+        r = self.sweep('0.5,7', '--resume', out=out)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        self.assertIn('mu0.1_f7_s1    taken up from its checkpoint %s' % ck, r.stdout)
+        self.assertEqual(calls(), {7.0: ck})
+        with open(os.path.join(runs, 'mu0.1_f7_s1.part1.bag')) as fh:
+            self.assertEqual(fh.read(), 'bag from the start')
+        with open(os.path.join(runs, 'mu0.1_f7_s1.bag')) as fh:
+            self.assertEqual(fh.read(), 'bag from the restart')
+        self.assertFalse(os.path.exists(ck))
+        # a checkpoint the run refuses (another build's) is removed; the next resume runs it afresh
+        stale = os.path.join(cks, 'mu0.1_f1_s1.ckpt')
+        with open(stale, 'w') as fh:
+            fh.write('refuse: written by another build')
+        r = self.sweep('0.5,1,7', '--resume', out=out)
+        self.assertEqual(r.returncode, 1, r.stdout)
+        self.assertIn('mu0.1_f1_s1    its checkpoint was refused and is removed', r.stdout)
+        self.assertFalse(os.path.exists(stale))
+        self.assertEqual(calls(), {1.0: stale})
+        r = self.sweep('0.5,1,7', '--resume', out=out)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        self.assertEqual(calls(), {1.0: '-'})
+        # a sweep started afresh takes up no checkpoint of an earlier one
+        with open(stale, 'w') as fh:
+            fh.write('the state of an earlier sweep')
+        r = self.sweep('0.5,1', out=out)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        self.assertEqual(calls(), {0.5: '-', 1.0: '-'})
 
     def test_a_resume_reruns_a_run_made_at_another_time_step(self):
         out = os.path.join(self.tmp, 'steps')

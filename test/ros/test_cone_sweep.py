@@ -1,14 +1,18 @@
 #!/usr/bin/env python3
 """The calibration sweep command on two tiny cone penetrometer cases (plus one it must refuse):
 it runs them through roslaunch in parallel, keeps the good runs when one fails, and writes the
-table, the fit and the plots; each run's bag holds the particles, the CI history and the result.
+table, the fit and the plots; each run's bag holds the particles, the CI history and the result;
+each run kept a checkpoint while it ran, and a run stopped through roslaunch and taken up from its
+checkpoint reads the sweep's cone index to the last bit.
 
     python3 test/ros/test_cone_sweep.py      (in a sourced catkin workspace)
 """
 import os
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 import rosbag
@@ -84,6 +88,49 @@ class ConeSweep(unittest.TestCase):
         self.assertIsNotNone(result)
         self.assertEqual(result.status, 'ok')
         self.assertAlmostEqual(result.cone_index_psi, res['cone_index_psi'], places=6)
+
+    def test_runs_kept_checkpoints_and_removed_them_once_ended(self):
+        for name in ('mu0.1_f0.5_s1', 'mu0.1_f8_s1'):
+            with open(os.path.join(self.out, 'runs', name + '.result.yaml')) as fh:
+                res = yaml.safe_load(fh)
+            self.assertGreaterEqual(res['checkpoints_written'], 1, name)  # (the first as the run began)
+        self.assertEqual(os.listdir(os.path.join(self.out, 'checkpoints')), [])
+
+    def test_a_run_stopped_and_taken_up_from_its_checkpoint_reads_the_same_cone_index(self):
+        with open(os.path.join(self.out, 'runs', 'mu0.1_f0.5_s1.result.yaml')) as fh:
+            swept = yaml.safe_load(fh)
+        out = tempfile.mkdtemp(prefix='dm_cone_restart_')
+        ck, bag = os.path.join(out, 'run.ckpt'), os.path.join(out, 'run.bag')
+        # the sweep's own arguments for the case (the checkpoint records them; a restart takes the same)
+        args = ['fidelity:=tiny', 'cohesion_factor:=0.5', 'friction:=0.1', 'seed:=1', 'dem_threads:=1',
+                'cloud_rate:=10', 'checkpoint:=' + ck, 'checkpoint_every:=1']
+
+        def launch(*more):
+            return subprocess.Popen(['roslaunch', '-p', '11791', 'dem_mobility', 'cone_penetrometer.launch',
+                                     'bag:=' + bag] + args + list(more),
+                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
+                                    env=dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:11791'))
+        p = launch()
+        t0 = time.time()
+        while not os.path.exists(ck) and time.time() - t0 < 120:
+            time.sleep(0.1)
+        time.sleep(1.0)
+        p.send_signal(signal.SIGINT)
+        text = p.communicate(timeout=120)[0]
+        with open(bag[:-4] + '.result.yaml') as fh:
+            stopped = yaml.safe_load(fh)
+        self.assertEqual(stopped['status'], 'interrupted', text)
+        self.assertEqual(stopped['checkpoint'], ck)
+        self.assertTrue(os.path.isfile(ck))
+        p = launch('restart:=' + ck)
+        text = p.communicate(timeout=300)[0]
+        with open(bag[:-4] + '.result.yaml') as fh:
+            again = yaml.safe_load(fh)
+        self.assertEqual(again['status'], 'ok', text)
+        self.assertEqual(again['restarted_from'], ck)
+        self.assertAlmostEqual(again['restarted_at'], stopped['checkpoint_at'], places=12)
+        self.assertEqual(again['cone_index_psi'], swept['cone_index_psi'])  # bit for bit
+        self.assertFalse(os.path.exists(ck))
 
 
 if __name__ == '__main__':

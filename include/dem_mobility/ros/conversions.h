@@ -34,8 +34,9 @@ core::DriverCommand FromMsg(const dem_mobility::DriverCommand& m);
 /// empty strings are unset), applied as dotted key=value overrides. Throws ConfigError naming the
 /// file (or the parameter).
 MobilityRunParams LoadScene(const ros::NodeHandle& nh);
-/// The same scene file with its overrides applied, for any kind of scene.
-YamlReader LoadSceneFile(const ros::NodeHandle& nh);
+/// The same scene file with its overrides applied, for any kind of scene; `overrides` (if given)
+/// receives them as key=value (what a checkpoint records of the run).
+YamlReader LoadSceneFile(const ros::NodeHandle& nh, std::vector<std::string>* overrides = nullptr);
 /// The exchange settings of a nodelet: `exchange_transport`, `exchange_spin` [s],
 /// `peer_timeout` [s], `startup_timeout` [s].
 ExchangeTiming LoadExchangeTiming(const ros::NodeHandle& pnh, std::string* transport);

@@ -19,16 +19,16 @@ class YamlReader;
 struct SceneRunOptions {
   std::string history_file;  ///< mobility runs: the speed history as CSV ("" none)
   bool quiet = false;        ///< no progress lines
-  /// Mobility runs: when it turns true (a signal handler sets it) the run ends at the next step
+  /// Mobility runs and soil rigs: when it turns true (a signal handler sets it) the run ends at the next step
   /// with what it has (status interrupted; the result and history are written).
   const std::atomic<bool>* stop = nullptr;
-  /// Mobility runs: the run's checkpoint ("" none), written when the run begins to step (the soil
-  /// prepared), every `checkpoint_every` wall seconds, and when it is stopped from outside; kept
+  /// Mobility runs and soil rigs: the run's checkpoint ("" none), written when the run begins to
+  /// step (a mobility run's soil prepared), every `checkpoint_every` wall seconds, and when it is stopped from outside; kept
   /// when the run stops with an error or is interrupted, removed once it has ended (its result
-  /// is then what remains). A restart from it goes on bit for bit (mobility/mobility_run.h).
+  /// is then what remains). A restart from it goes on bit for bit (common/checkpoint.h).
   std::string checkpoint_file;
   double checkpoint_every = 600.0;  ///< [s] of wall time
-  /// Mobility runs: take the run up from this checkpoint ("" from the start); it must be of the
+  /// Mobility runs and soil rigs: take the run up from this checkpoint ("" from the start); it must be of the
   /// same scene file, overrides, input files and build.
   std::string restart_file;
   /// Mobility runs: the folder of prepared soils ("" none; PreparationHooks::prepared_soil_cache).

@@ -31,6 +31,7 @@ import yaml
 
 from .. import sweep as dm_sweep
 from ..sweep import keep as dm_keep
+from ..sweep.checkpoints import checkpoint_path, keep_bag_part, refused_checkpoint
 from ..paths import CONFIG, ROOT
 from ..runs import scene_command
 from ..sweep.args import floats, git_commit, ints, keep_options, ros_package, sha256
@@ -327,6 +328,10 @@ def parser():
     ap.add_argument('--cloud-rate', type=float, default=5.0, help='particle clouds per simulated second in each bag')
     ap.add_argument('--timeout', type=float, default=3600.0, help='longest a run may take [s]')
     ap.add_argument('--port', type=int, default=11411, help='first ROS master port (one per parallel run)')
+    ap.add_argument('--checkpoint-every', type=float, default=300.0,
+                    help='wall seconds between a run\'s checkpoints in OUT/checkpoints (default 300); a run '
+                         'stopped before its end (the sweep stopped, its machine gone) is taken up from its '
+                         'checkpoint by --resume, by the same build')
     ap.add_argument('--table-ci', type=floats, default=floats(','.join(str(c) for c, _ in PAPER_TABLE)),
                     help="cone indices of the table's rows (the paper's by default)")
     ap.add_argument('--install', help='also copy the tables into this directory (e.g. config/calibration), or '
@@ -348,6 +353,9 @@ def check_args(a):
     level's runs (--finest), or None."""
     if a.jobs < 1 or a.dem_threads < 1:
         sys.exit('dm-calibrate: --jobs and --dem-threads must be >= 1')
+    if not 1.0 <= a.checkpoint_every <= 1e7:
+        sys.exit('dm-calibrate: --checkpoint-every %g: wall seconds between checkpoints are from 1 to 1e7'
+                 % a.checkpoint_every)
     if not a.seeds or len(set(a.seeds)) != len(a.seeds) or min(a.seeds) < 0:
         sys.exit('dm-calibrate: --seeds must list distinct seeds >= 0')
     if not os.path.isfile(a.scene):
@@ -377,6 +385,7 @@ def check_args(a):
 def make_sweep(a, conditions, scene_sha, soil_sha):
     """The sweep's cases and its Sweep (the runs kept by --resume taken in)."""
     os.makedirs(os.path.join(a.out, 'runs'), exist_ok=True)
+    os.makedirs(os.path.join(a.out, 'checkpoints'), exist_ok=True)
     try:
         at = dict(a.seeds_at)
         cases = dm_sweep.cases([{'mu': mu, 'f': f, 'seed': sd} for mu in a.mu for f in a.f for sd in at.get(f, a.seeds)],
@@ -385,15 +394,25 @@ def make_sweep(a, conditions, scene_sha, soil_sha):
         sys.exit('dm-calibrate: %s' % e)
 
     steps = dict(a.time_step_at)
+    if not a.resume:  # (a sweep started afresh takes up no run of an earlier one)
+        for c in cases:
+            if os.path.exists(checkpoint_path(a.out, c.name)):
+                os.remove(checkpoint_path(a.out, c.name))
 
     def command(case, run):
         step = [('time_step', steps[case['f']])] if case['f'] in steps else []
+        ck = checkpoint_path(a.out, case.name)
+        restart = ck if os.path.isfile(ck) else ''
+        if restart:
+            keep_bag_part(a.out, case.name)
+            sweep.line('           ...    %-14s taken up from its checkpoint %s' % (case.name, ck))
         return scene_command('roslaunch', 'cone_penetrometer.launch',
                              [('fidelity', a.fidelity), ('cohesion_factor', float(case['f'])),
                               ('friction', float(case['mu'])), ('seed', int(case['seed'])), ('dem_threads', a.dem_threads)]
                              + step,
                              scene=a.scene, port=run.port, bag=bag_path(a.out, case.name),
-                             launch_args=[('cloud_rate', float(a.cloud_rate))])
+                             launch_args=[('cloud_rate', float(a.cloud_rate)), ('checkpoint', ck),
+                                          ('checkpoint_every', float(a.checkpoint_every)), ('restart', restart)])
 
     def check(case, result):
         return None if result.get('window_samples') else 'no CI sample in the window'
@@ -427,9 +446,16 @@ def make_sweep(a, conditions, scene_sha, soil_sha):
                           lambda o: 'calibration: run %s at %s (%s)' % (o.name, a.fidelity, describe(o)),
                           {'kept_from_commit': commit}, lambda text: sweep.line(text))
 
+    def done(o):
+        keep(o)
+        refused_checkpoint(o, checkpoint_path(a.out, o.name), sweep.line)
+
+    # (a run taken up from its checkpoint keeps the bag of its part before: keep_bag_part)
     sweep = dm_sweep.Sweep(cases, command, os.path.join(a.out, 'runs'), jobs=a.jobs, port=a.port,
-                           timeout=a.timeout, check=check, outputs=lambda case: [bag_path(a.out, case.name)],
-                           describe=describe, poll=1.0, status_every=20.0, on_done=keep)
+                           timeout=a.timeout, check=check,
+                           outputs=lambda case: ([] if os.path.isfile(checkpoint_path(a.out, case.name))
+                                                 else [bag_path(a.out, case.name)]),
+                           describe=describe, poll=1.0, status_every=20.0, on_done=done)
     if a.resume:
         if a.keep:
             dm_keep.restore_kept(a.keep, sweep.runs_dir, [c.name for c in cases], sweep.outcome_file)

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 #include "dem_mobility/core/dem/dem_shapes.h"
 #include "dem_mobility/core/soil/soil_prep.h"
@@ -337,7 +338,7 @@ ConeResult ConePenetrometer::Result() const {
   r.sim_time = dem_->time();
   r.time_step = p_.level.time_step;
   r.steps = dem_->step_count();
-  r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+  r.wall_time = WallTime();
   r.error = error_;
   if (r.error.empty() && phase_ != Phase::kDone) r.error = "interrupted in phase " + phase();
   return r;
@@ -393,5 +394,28 @@ ResultFile ConeResultFile(const ConeResult& r, const ConeParams& p) {
 }
 
 ResultFile ConePenetrometer::Report() const { return ConeResultFile(Result(), p_); }
+
+double ConePenetrometer::WallTime() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+}
+
+template <class Ar>
+void ConePenetrometer::Io(Ar& ar) {
+  ar.Tag("cone_penetrometer");
+  dem_->Io(ar);
+  prep_->Io(ar);
+  ar.Tag("cone");
+  double wall = WallTime();  // (the run's wall time so far goes on counting after a restart)
+  ar(phase_, z_tip_, v_tip_, integral_, z0_, t0_, surface_, sample_force_, sample_z_, sample_t_, sample_steps_,
+     samples_, wall);
+  if constexpr (Ar::kLoading) {
+    if (static_cast<int>(phase_) < 0 || phase_ > Phase::kDone) ar.Fail("the cone's phase is not one");
+    wall0_ = std::chrono::steady_clock::now() -
+             std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wall));
+  }
+}
+
+void ConePenetrometer::SaveState(StateWriter& out) const { const_cast<ConePenetrometer*>(this)->Io(out); }
+void ConePenetrometer::LoadState(StateReader& in) { Io(in); }
 
 }  // namespace dem_mobility::core

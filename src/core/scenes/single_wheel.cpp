@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "dem_mobility/core/common/error.h"
+#include "dem_mobility/core/common/state_archive.h"
 #include "dem_mobility/core/common/yaml_reader.h"
 
 namespace dem_mobility::core {
@@ -152,6 +153,25 @@ std::string SingleWheelRig::phase() const {
 double SingleWheelRig::wall_time() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
 }
+
+template <class Ar>
+void SingleWheelRig::Io(Ar& ar) {
+  ar.Tag("single_wheel");
+  bin_->Io(ar);
+  ar.Tag("wheel");
+  wheel_.Io(ar);
+  double wall = wall_time();  // (the run's wall time so far goes on counting after a restart)
+  ar(phase_, x0_, x_, z_, vz_, v_, omega_, theta_, t_phase_, dp_, torque_, accel_, sunk_, s_dp_, s_torque_, s_fz_,
+     s_sink_, s_omega_, s_t0_, s_x0_, s_n_, rest_fz_, rest_sink_, rest_n_, samples_, prep_wall_time_, wall);
+  if constexpr (Ar::kLoading) {
+    if (static_cast<int>(phase_) < 0 || phase_ > Phase::kDone) ar.Fail("the wheel rig's phase is not one");
+    wall0_ = std::chrono::steady_clock::now() -
+             std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wall));
+  }
+}
+
+void SingleWheelRig::SaveState(StateWriter& out) const { const_cast<SingleWheelRig*>(this)->Io(out); }
+void SingleWheelRig::LoadState(StateReader& in) { Io(in); }
 
 double SingleWheelRig::sinkage() const { return bin_->surface_height() - (z_ - p_.tire.radius); }
 

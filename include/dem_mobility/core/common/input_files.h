@@ -1,6 +1,6 @@
 // The input files a process has read (configuration YAML, meshes), each with the fingerprint of
 // the bytes it read: what a checkpoint records of the run it holds, so that a restart can refuse
-// to go on with any of them changed (common/state_archive.h, mobility/checkpoint.h).
+// to go on with any of them changed (common/state_archive.h, common/checkpoint.h).
 //
 // A file read is noted only in the records alive at that moment (InputFileRecord), each path once:
 // a process that loads files again and again without a record (a fuzzer, a node that reloads its

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "dem_mobility/core/common/checkpoint.h"
 #include "dem_mobility/core/common/input_files.h"
 #include "dem_mobility/core/mobility/cosim_loop.h"
 #include "dem_mobility/core/terrain/terrain_model.h"
@@ -15,34 +16,6 @@
 namespace dem_mobility::core {
 
 class StateReader;
-
-/// What a checkpoint says of the run it holds: the scene and overrides it was started with, every
-/// input file it read (with the fingerprint of its bytes), the executable that ran it, and where
-/// the run was. A restart goes on only with all of them the same, so that the run taken up again
-/// is, bit for bit, the run that was written.
-struct CheckpointIdentity {
-  std::string scene_file;              ///< absolute
-  std::vector<std::string> overrides;  ///< key=value, as given
-  std::vector<InputFile> files;
-  uint64_t executable = 0;             ///< ExecutableFingerprint()
-  long step = 0;                       ///< the vehicle's step
-  double driver_time = 0.0;            ///< [s] since the driver's start (< 0: settling)
-  template <class Ar>
-  void Io(Ar& ar) {
-    ar.Tag("identity");
-    ar(scene_file, overrides, files, executable, step, driver_time);
-  }
-  /// ConfigError naming `checkpoint` and what differs from the run asked for now (`scene_file`
-  /// and `overrides`): another scene or overrides, an input file changed or gone, another build.
-  void CheckRestart(const std::string& checkpoint, const std::string& scene_file,
-                    const std::vector<std::string>& overrides) const;
-  /// What it is, for a person: the scene, the overrides, where the run was, whether this build
-  /// wrote it and whether each input file is unchanged.
-  std::string Describe() const;
-};
-
-/// The identity of the checkpoint `path` (its header and checksum checked; nothing is built).
-CheckpointIdentity ReadCheckpointIdentity(const std::string& path);
 
 class MobilityRun {
  public:

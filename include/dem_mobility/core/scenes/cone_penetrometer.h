@@ -80,6 +80,7 @@ struct ConeSample {
   double speed = 0.0;   ///< downward [m/s]
   double force = 0.0;   ///< the soil's upward force on the penetrometer [N]
   double cone_index_psi = 0.0;  ///< force / base area [psi]
+  using StateBulk = void;       ///< (plain doubles: a checkpoint copies it as bytes)
 };
 
 struct ConeResult {
@@ -118,6 +119,8 @@ class ConePenetrometer final : public SoilRig {
   std::string StatusLine() const override;
   std::vector<int> moving_walls() const override { return {cone_, rod_, lid_}; }
   ResultFile Report() const override;
+  void SaveState(StateWriter& out) const override;
+  void LoadState(StateReader& in) override;
 
   /// Steps to the end; `progress(*this)` is called every `every` steps. Numerical failures end
   /// the run with `error` set and what was measured so far.
@@ -146,6 +149,9 @@ class ConePenetrometer final : public SoilRig {
   void StepCone();
   void StartPenetration();
   void Sample();
+  template <class Ar>
+  void Io(Ar& ar);
+  double WallTime() const;
 
   ConeParams p_;
   std::unique_ptr<DemSystem> dem_;

@@ -70,6 +70,7 @@ struct WheelSample {
   double torque = 0.0;     ///< drive torque [N m]
   double vertical_force = 0.0;  ///< soil's on the wheel [N]
   int contacts = 0;
+  using StateBulk = void;  ///< (plain data: a checkpoint copies it as bytes)
 };
 
 class SingleWheelRig final : public SoilRig {
@@ -98,6 +99,8 @@ class SingleWheelRig final : public SoilRig {
   std::string StatusLine() const override;
   std::vector<int> moving_walls() const override { return {bin_->tire_wall(0), bin_->lid_wall()}; }
   ResultFile Report() const override;
+  void SaveState(StateWriter& out) const override;
+  void LoadState(StateReader& in) override;
 
   const SingleWheelParams& params() const { return p_; }
   const DemSoilBin& bin() const { return *bin_; }
@@ -133,6 +136,8 @@ class SingleWheelRig final : public SoilRig {
   void Place();
   void StepWheel();
   void Sample();
+  template <class Ar>
+  void Io(Ar& ar);
 
   SingleWheelParams p_;
   std::unique_ptr<DemSoilBin> bin_;
