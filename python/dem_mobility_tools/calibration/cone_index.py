@@ -441,8 +441,9 @@ def make_sweep(a, conditions, scene_sha, soil_sha):
         sys.exit('dm-calibrate: %s' % e)
     commit = git_commit(ROOT)
 
-    # a good run's compact result into --keep (committed with --commit) as it ends
-    keep = dm_keep.keeper(a.keep, a.commit, ROOT,
+    # a good run's compact result into --keep (committed with --commit, in the checkout that holds
+    # DIR: a sweep run from a pinned build keeps into the working checkout) as it ends
+    keep = dm_keep.keeper(a.keep, a.commit, None,
                           lambda o: 'calibration: run %s at %s (%s)' % (o.name, a.fidelity, describe(o)),
                           {'kept_from_commit': commit}, lambda text: sweep.line(text))
 

@@ -433,8 +433,9 @@ def main(argv=None):
     runs_dir = os.path.join(a.out, 'runs')
     os.makedirs(runs_dir, exist_ok=True)
 
-    # a finished run's compact result into --keep (committed with --commit) as it ends
-    keep = dm_keep.keeper(a.keep, a.commit, ROOT,
+    # a finished run's compact result into --keep (committed with --commit, in the checkout that
+    # holds DIR: a sweep run from a pinned build keeps into the working checkout) as it ends
+    keep = dm_keep.keeper(a.keep, a.commit, None,
                           lambda o: 'single wheel: run %s at %s (%s)' % (o.name, a.fidelity, describe(o)),
                           {'kept_from_commit': git_commit(ROOT)}, lambda text: sweep.line(text))
     # the progress lines of a running run: the rig nodelet's 'progress: ...', dm_run_scene's '... s wall  ...'
