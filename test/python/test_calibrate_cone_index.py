@@ -349,6 +349,20 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stdout)
         self.assertEqual(calls(), {0.5: '-', 1.0: '-'})
 
+    def test_no_table_runs_one_f_alone_and_refuses_what_needs_a_table(self):
+        out = os.path.join(self.tmp, 'no_table')
+        r = self.sweep('1', '--no-table', '--time-step-at', '1=6e-5', out=out)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        with open(os.path.join(out, 'runs', 'mu0.1_f1_s1.result.yaml')) as fh:
+            self.assertEqual(yaml.safe_load(fh)['time_step'], 6e-5)
+        self.assertFalse([n for n in os.listdir(out) if n.startswith('cone_index_')], os.listdir(out))
+        r = self.sweep('1', out=os.path.join(self.tmp, 'one_f'))
+        self.assertNotEqual(r.returncode, 0, r.stdout)
+        self.assertIn('--f needs two cohesion factors at least', r.stdout)
+        r = self.sweep('1,2', '--no-table', '--install', self.tmp, out=os.path.join(self.tmp, 'no_install'))
+        self.assertNotEqual(r.returncode, 0, r.stdout)
+        self.assertIn('--no-table makes no table to --install', r.stdout)
+
     def test_a_resume_reruns_a_run_made_at_another_time_step(self):
         out = os.path.join(self.tmp, 'steps')
 

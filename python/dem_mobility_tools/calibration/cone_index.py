@@ -32,6 +32,7 @@ import yaml
 from .. import sweep as dm_sweep
 from ..sweep import keep as dm_keep
 from ..sweep.checkpoints import checkpoint_path, keep_bag_part, refused_checkpoint
+from .figures import plots
 from ..paths import CONFIG, ROOT
 from ..runs import scene_command
 from ..sweep.args import floats, git_commit, ints, keep_options, ros_package, sha256
@@ -253,58 +254,6 @@ def fit(points, table_ci):
     return cubic, table, band, method, cubic_residual
 
 
-def plots(runs, out, mus, fits):
-    import matplotlib
-    matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
-    import numpy as np
-    written = []
-    for mu in mus:
-        done = [r for r in runs if r.mu == mu and r.result and r.result.get('history')]
-        if not done:
-            continue
-        fig, ax = plt.subplots(figsize=(8, 5))
-        for r in sorted(done, key=lambda r: r.f):
-            h = r.result['history']
-            ax.plot(h['t'], h['cone_index_psi'], lw=1.2, label='f = %g, seed %d%s' % (r.f, r.seed, '' if r.ok() else ' (failed)'))
-        ax.set_xlabel('time since the cone started [s]')
-        ax.set_ylabel('cone index [psi]')
-        ax.set_title('CI versus time, mu = %g (paper fig. 13)' % mu)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-        p = os.path.join(out, 'ci_vs_time_mu%g.png' % mu)
-        fig.tight_layout()
-        fig.savefig(p, dpi=110)
-        plt.close(fig)
-        written.append(p)
-    fig, ax = plt.subplots(figsize=(8, 5))
-    for mu in mus:
-        pts = sorted((r.f, r.ci()) for r in runs if r.mu == mu and r.ok())
-        if not pts:
-            continue
-        line = ax.plot([p[0] for p in pts], [p[1] for p in pts], 'o', mfc='none', label='runs, mu = %g' % mu)[0]
-        mp = mean_points(pts)
-        ax.errorbar([p[0] for p in mp], [p[1] for p in mp], yerr=[p[2] or 0.0 for p in mp], fmt='s',
-                    color=line.get_color(), capsize=3, label='mean and std over the seeds, mu = %g' % mu)
-        if mu in fits:
-            table = fits[mu][1]
-            ax.plot([t[1] for t in table], [t[0] for t in table], '-', color=line.get_color(),
-                    label='table (fit), mu = %g' % mu)
-    ax.plot([t[1] for t in PAPER_TABLE], [t[0] for t in PAPER_TABLE], 'k--', lw=1, label='paper, table 3 (mu = 0.1)')
-    ax.set_xscale('log')
-    ax.set_xlabel('cohesion factor f')
-    ax.set_ylabel('cone index [psi]')
-    ax.set_title('CI versus cohesion factor (paper fig. 14)')
-    ax.grid(alpha=0.3, which='both')
-    ax.legend(fontsize=8)
-    p = os.path.join(out, 'ci_vs_f.png')
-    fig.tight_layout()
-    fig.savefig(p, dpi=110)
-    plt.close(fig)
-    written.append(p)
-    return written
-
-
 def parser():
     """dm-calibrate's command line."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -336,6 +285,9 @@ def parser():
                     help="cone indices of the table's rows (the paper's by default)")
     ap.add_argument('--install', help='also copy the tables into this directory (e.g. config/calibration), or '
                                       'the mu = 0.1 table to this file')
+    ap.add_argument('--no-table', action='store_true',
+                    help='the runs alone, no table (e.g. one f at another time step, to compare with a table\'s '
+                         'run); one f is then enough')
     ap.add_argument('--resume', action='store_true',
                     help='keep the runs already in OUT that succeeded with the same level, f, mu and seed (rerun the rest)')
     ap.add_argument('--out', default='results/calibration')
@@ -368,9 +320,11 @@ def check_args(a):
         sys.exit('dm-calibrate: --commit commits what --keep DIR writes: name the folder')
     if a.install and a.install.endswith(os.sep) and not os.path.isdir(a.install):
         sys.exit('dm-calibrate: --install %s: no such directory' % a.install)
-    if len(set(a.f)) < 2 or not a.mu:
-        sys.exit('dm-calibrate: --f needs two cohesion factors at least (a table is a fit) and --mu one '
-                 'friction at least')
+    if (len(set(a.f)) < 2 and not a.no_table) or not a.mu:
+        sys.exit('dm-calibrate: --f needs two cohesion factors at least (a table is a fit; --no-table for runs '
+                 'alone) and --mu one friction at least')
+    if a.no_table and (a.install or a.finest):
+        sys.exit('dm-calibrate: --no-table makes no table to --install or to compare with --finest')
     finest_ref = None
     if a.finest:
         try:
@@ -575,7 +529,7 @@ def main(argv=None):
         sys.exit('dm-calibrate: interrupted; finished runs are in %s' % a.out)
     runs = [Run(o, a.out) for o in sweep.outcomes]
     fits = {}
-    for mu in a.mu:
+    for mu in ([] if a.no_table else a.mu):
         made = write_table(a, mu, runs, finest_ref, diameter,
                            (commit, soil_file, soil_sha, scene_sha, conditions, root))
         if made is not None:
@@ -586,7 +540,7 @@ def main(argv=None):
     write_summary(a, runs, t0)
     print('sweep: %d runs in %.0f s, %d failed%s' % (len(runs), time.time() - t0, len(failed),
                                                     ''.join('\n  failed: %s: %s' % (r.name, r.error) for r in failed)))
-    no_table = [mu for mu in a.mu if mu not in fits]
+    no_table = [mu for mu in a.mu if mu not in fits and not a.no_table]
     if no_table:
         print('dm-calibrate: no table for mu %s (fewer than two f values with a good run)'
               % ', '.join('%g' % mu for mu in no_table), file=sys.stderr)
