@@ -35,6 +35,9 @@ dt = float(args.get('time_step') or 1.2e-4)   # (the tiny level's step unless on
 ck, restart = args.get('checkpoint', ''), args.get('restart', '')
 with open(os.path.join(os.path.dirname(bag), 'calls'), 'a') as fh:
     fh.write('%%g %%g %%s %%d %%g %%s\n' %% (f, mu, sys.argv[2], seed, dt, restart or '-'))
+if args.get('overrides'):
+    with open(os.path.join(os.path.dirname(bag), 'overrides'), 'a') as fh:
+        fh.write(args['overrides'] + '\n')
 res = bag[:-4] + '.result.yaml'
 # as the rig nodelet: a checkpoint it cannot take up fails the run naming it; one of this run is
 # taken up; the run's checkpoint is written as it begins, its bag as it goes
@@ -362,6 +365,31 @@ class CalibrationSweepWithoutRos(unittest.TestCase):
         r = self.sweep('1,2', '--no-table', '--install', self.tmp, out=os.path.join(self.tmp, 'no_install'))
         self.assertNotEqual(r.returncode, 0, r.stdout)
         self.assertIn('--no-table makes no table to --install', r.stdout)
+
+    def test_set_passes_other_scene_keys_to_every_run_and_a_resume_checks_them(self):
+        out = os.path.join(self.tmp, 'set')
+        r = self.sweep('1', '--no-table', '--set', 'levels.tiny.container_diameter=0.9', '--set', 'pid.kp=2e8',
+                       out=out)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        with open(os.path.join(out, 'runs', 'overrides')) as fh:
+            self.assertEqual(yaml.safe_load(fh.read()), {'levels': {'tiny': {'container_diameter': 0.9}},
+                                                         'pid': {'kp': '2e8'}})  # (YAML 1.1: the scene reads it as 2e8)
+        with open(os.path.join(out, 'sweep_options.yaml')) as fh:
+            self.assertEqual(yaml.safe_load(fh)['--set'], ['levels.tiny.container_diameter=0.9', 'pid.kp=2e8'])
+        # a resume with other keys, or none, is refused naming --set; a folder made before --set holds none
+        for more in (['--set', 'levels.tiny.container_diameter=1.0'], []):
+            r = self.sweep('1', '--no-table', '--resume', *more, out=out)
+            self.assertNotEqual(r.returncode, 0, r.stdout)
+            self.assertIn('holds runs made with --set', r.stdout)
+        r = self.sweep('0.5,8', '--resume', '--set', 'levels.tiny.container_diameter=1.0')
+        self.assertNotEqual(r.returncode, 0, r.stdout)
+        self.assertIn('holds runs made with --set []', r.stdout)
+        # the sweep's own keys, and what is no KEY=VALUE, are refused before any run
+        for bad, said in (('seed=3', 'seed is set by the sweep itself'), ('levels..x=1', 'KEY=VALUE'),
+                          ('container', 'KEY=VALUE')):
+            r = self.sweep('1', '--no-table', '--set', bad, out=os.path.join(self.tmp, 'set_bad'))
+            self.assertEqual(r.returncode, 2, r.stdout)
+            self.assertIn(said, r.stdout)
 
     def test_a_resume_reruns_a_run_made_at_another_time_step(self):
         out = os.path.join(self.tmp, 'steps')

@@ -63,6 +63,38 @@ def time_step_at(text):
     return f, dt
 
 
+# the keys a sweep sets per case (or for all of them): --set may not set them
+SWEEP_KEYS = ('fidelity', 'cohesion_factor', 'friction', 'seed', 'threads', 'time_step', 'cone_index', 'f', 'mu')
+
+
+def scene_setting(text):
+    """--set KEY=VALUE: a dotted key of the scene file and a YAML value ('levels.coarse_cal.container_diameter=2.0')."""
+    key, eq, value = text.partition('=')
+    if not eq or not key or not value or any(not part for part in key.split('.')):
+        raise argparse.ArgumentTypeError('%r: KEY=VALUE, a dotted key of the scene file' % text)
+    if key.split('.')[0] in SWEEP_KEYS:
+        raise argparse.ArgumentTypeError('%r: %s is set by the sweep itself (its own options)' % (text, key.split('.')[0]))
+    try:
+        parsed = yaml.safe_load(value)
+    except yaml.YAMLError as e:
+        raise argparse.ArgumentTypeError('%r: the value is no YAML: %s' % (text, e))
+    return key, parsed, value
+
+
+def settings_yaml(settings):
+    """The --set keys as one YAML map in flow style, the launch files' `overrides:=` ('' none)."""
+    tree = {}
+    for key, value, _ in settings:
+        node = tree
+        parts = key.split('.')
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise ValueError('--set %s: %s is set to a value and is a map too' % (key, part))
+        node[parts[-1]] = value
+    return yaml.safe_dump(tree, default_flow_style=True, width=1 << 20).strip() if tree else ''
+
+
 def case_name(mu, f, seed):
     return 'mu%g_f%g_s%d' % (mu, f, seed)
 
@@ -285,6 +317,10 @@ def parser():
                     help="cone indices of the table's rows (the paper's by default)")
     ap.add_argument('--install', help='also copy the tables into this directory (e.g. config/calibration), or '
                                       'the mu = 0.1 table to this file')
+    ap.add_argument('--set', type=scene_setting, action='append', default=[], metavar='KEY=VALUE',
+                    help='any other key of the scene file for every run (dotted, a YAML value), e.g. '
+                         'levels.coarse_cal.container_diameter=2.0 for a set-up study (with --no-table); may be '
+                         'repeated; kept in the folder\'s options, so a --resume with others is refused')
     ap.add_argument('--no-table', action='store_true',
                     help='the runs alone, no table (e.g. one f at another time step, to compare with a table\'s '
                          'run); one f is then enough')
@@ -348,6 +384,10 @@ def make_sweep(a, conditions, scene_sha, soil_sha):
         sys.exit('dm-calibrate: %s' % e)
 
     steps = dict(a.time_step_at)
+    try:
+        overrides = settings_yaml(a.set)
+    except ValueError as e:
+        sys.exit('dm-calibrate: %s' % e)
     if not a.resume:  # (a sweep started afresh takes up no run of an earlier one)
         for c in cases:
             if os.path.exists(checkpoint_path(a.out, c.name)):
@@ -365,7 +405,7 @@ def make_sweep(a, conditions, scene_sha, soil_sha):
                               ('friction', float(case['mu'])), ('seed', int(case['seed'])), ('dem_threads', a.dem_threads)]
                              + step,
                              scene=a.scene, port=run.port, bag=bag_path(a.out, case.name),
-                             launch_args=[('cloud_rate', float(a.cloud_rate)), ('checkpoint', ck),
+                             launch_args=[('cloud_rate', float(a.cloud_rate)), ('overrides', overrides), ('checkpoint', ck),
                                           ('checkpoint_every', float(a.checkpoint_every)), ('restart', restart)])
 
     def check(case, result):
@@ -386,11 +426,13 @@ def make_sweep(a, conditions, scene_sha, soil_sha):
 
     # the scene, its level and soil as the runs are made with them: a resume with others is refused
     # (and in --keep, which a resume from another checkout reads: the scene by its hash there)
-    options = {'scene_sha256': scene_sha, 'soil_sha256': soil_sha, '--fidelity': a.fidelity, 'conditions': conditions}
+    options = {'scene_sha256': scene_sha, 'soil_sha256': soil_sha, '--fidelity': a.fidelity, 'conditions': conditions,
+               '--set': ['%s=%s' % (k, text) for k, _, text in a.set]}
     try:
-        keep_options(a.out, dict(options, **{'--scene': os.path.abspath(a.scene)}), a.resume)
+        # (a folder from before --set was made without one)
+        keep_options(a.out, dict(options, **{'--scene': os.path.abspath(a.scene)}), a.resume, {'--set': []})
         if a.keep:
-            keep_options(a.keep, options, a.resume)
+            keep_options(a.keep, options, a.resume, {'--set': []})
     except ValueError as e:
         sys.exit('dm-calibrate: %s' % e)
     commit = git_commit(ROOT)

@@ -66,15 +66,17 @@ def sha256(path):
     return h.hexdigest()
 
 
-def keep_options(out, options, resume):
+def keep_options(out, options, resume, defaults=None):
     """The options a sweep's results depend on and no result file holds (a driving time, a seed,
     a scene file and its hash, ...), written to OUT/sweep_options.yaml; with `resume`, ValueError
     naming the first option whose value differs from the one the folder's runs were made with
-    (an option the folder's file does not name, written by an older version, is not compared)."""
+    (an option the folder's file does not name, written by an older version, is not compared,
+    unless `defaults` gives the value it had then)."""
     path = os.path.join(out, OPTIONS_FILE)
     if resume and os.path.exists(path):
         with open(path) as fh:
             old = yaml.safe_load(fh) or {}
+        old = dict(defaults or {}, **old)
         for key, value in options.items():
             if key in old and old[key] != value:
                 raise ValueError('--resume: %s holds runs made with %s %s, not %s' % (out, key, old[key], value))
