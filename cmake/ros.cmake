@@ -46,6 +46,7 @@ catkin_install_python(PROGRAMS
   python/bin/dm-docs
   python/bin/dm-docs-cone
   python/bin/dm-docs-wheel
+  python/bin/dm-docs-cone-setup
   DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)

@@ -280,3 +280,48 @@ class WheelData(RepoCopy):
         with self.assertRaises(make.DocsError) as e:
             wheel_data.write(self.tmp, [empty], 'm', 'd')
         self.assertIn(empty, str(e.exception))
+
+
+class ConeSetupData(RepoCopy):
+    """dm-docs-cone-setup: a set-up folder's runs against the table's runs of the same f and seed, the
+    table's scatter over its seeds, the seeds' means of a knob run at several; what cannot be compared is
+    refused naming it."""
+
+    RUN = {'kind': 'cone_penetrometer', 'status': 'ok', 'fidelity': 'coarse_cal', 'particle_diameter': 0.06,
+           'friction': 0.1, 'container_diameter': 1.2, 'soil_depth': 1.6, 'cone_speed': 0.1,
+           'kept_from_commit': 'abc1234'}
+
+    def kept(self, name, runs, options):
+        import yaml
+        folder = os.path.join(self.tmp, name)
+        os.makedirs(folder)
+        with open(os.path.join(folder, 'sweep_options.yaml'), 'w') as f:
+            yaml.safe_dump(dict({'--fidelity': 'coarse_cal'}, **options), f)
+        for (f_, seed), ci in runs.items():
+            with open(os.path.join(folder, 'mu0.1_f%g_s%d.yaml' % (f_, seed)), 'w') as f:
+                yaml.safe_dump(dict(self.RUN, cohesion_factor=f_, seed=seed, cone_index_psi=ci), f)
+        return folder
+
+    def test_rows_against_the_same_seed(self):
+        import yaml
+        from dem_mobility_tools.docsgen import cone_setup
+        table = self.kept('table', {(1, 1): 60.0, (1, 2): 66.0, (1, 3): 63.0, (5, 1): 230.0, (5, 2): 240.0}, {})
+        wide = self.kept('wide', {(1, 1): 63.0, (5, 1): 220.0, (5, 2): 252.0},
+                         {'--set': ['levels.coarse_cal.container_diameter=2.0']})
+        with open(cone_setup.write(self.tmp, table, [wide], 'a test machine')) as f:
+            t = yaml.safe_load(f)
+        self.assertEqual(t['table'], 'cone/setup_d0.06')
+        r = t['rows']
+        self.assertEqual([(x['f'], x['seeds'], x['ci'], x['change']) for x in r],
+                         [(1, '1, 2, 3', 63.0, '—'), (1, '1', 63.0, '+5.0 %'),
+                          (5, '1, 2', 235.0, '—'), (5, '1', 220.0, '-4.3 %'), (5, '2', 252.0, '+5.0 %'),
+                          (5, '1, 2', 236.0, '+0.4 %')])
+        self.assertEqual(r[1]['what'], 'container 2.0 m (1.2)')
+        self.assertEqual(r[0]['seed_scatter'], '3.0 (4.8 %; 3 seeds: 60.0, 66.0, 63.0)')
+        # a seed the table does not hold, a folder of no set-up, another level: refused, naming it
+        for bad, said in ((self.kept('s9', {(1, 9): 60.0}, {'--set': ['seed_x=1']}), 'seed 9'),
+                          (self.kept('plain', {(1, 1): 60.0}, {}), 'no --set'),
+                          (self.kept('other', {(1, 1): 60.0}, {'--fidelity': 'tiny_cal', '--set': ['a=1']}), 'tiny_cal')):
+            with self.assertRaises(make.DocsError) as e:
+                cone_setup.write(self.tmp, table, [bad], 'm')
+            self.assertIn(said, str(e.exception))
