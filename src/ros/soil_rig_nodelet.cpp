@@ -68,6 +68,7 @@ class SoilRigNodelet : public nodelet::Nodelet {
         ResultFile::CheckWritable(ck.file + ".writing", "parameter " + pnh.resolveName("checkpoint_file"));
         std::remove((ck.file + ".writing").c_str());
       }
+      ck_file_ = ck.file;
       checkpoints_ = std::make_unique<RigCheckpoints>(ck);
       // ConfigError naming the file and key for a scene that is no rig, or naming the checkpoint
       // for one that is not of this run
@@ -135,7 +136,11 @@ class SoilRigNodelet : public nodelet::Nodelet {
           break;
         }
         rig_->Step();
+        const int written = checkpoints_->written();
         checkpoints_->AfterStep(*rig_);
+        if (checkpoints_->written() > written)
+          NODELET_INFO("checkpoint %s: t = %.3f s, %.1f MB in %.2f s", ck_file_.c_str(), checkpoints_->last_time(),
+                       checkpoints_->last_bytes() / 1e6, checkpoints_->last_seconds());
         const long k = s.step_count();
         if ((k & 1023) == 0 && std::chrono::steady_clock::now() > next_progress) {
           next_progress = std::chrono::steady_clock::now() + std::chrono::seconds(10);
@@ -241,7 +246,7 @@ class SoilRigNodelet : public nodelet::Nodelet {
   std::unique_ptr<RigCheckpoints> checkpoints_;
   std::unique_ptr<SoilRig> rig_;
   std::unique_ptr<RigTopics> topics_;
-  std::string scene_file_, frame_id_ = "map", result_file_;
+  std::string scene_file_, frame_id_ = "map", result_file_, ck_file_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
   RecorderWatch recorder_;  ///< the bag recorder's failure ends the run with its error

@@ -296,7 +296,13 @@ ResultFile RunRig(const YamlReader& reader, const SceneRunOptions& o,
         break;
       }
       rig->Step();
+      const int written = checkpoints.written();
       checkpoints.AfterStep(*rig);
+      if (checkpoints.written() > written && !o.quiet) {
+        std::printf("  checkpoint %s: t = %.3f s, %.1f MB in %.2f s\n", o.checkpoint_file.c_str(), checkpoints.last_time(),
+                    checkpoints.last_bytes() / 1e6, checkpoints.last_seconds());
+        std::fflush(stdout);
+      }
       if (!o.quiet && rig->dem().step_count() % 500 == 0 && ticker.Due()) {
         std::printf("  %7.1f s wall  %s\n", ticker.Elapsed(), rig->StatusLine().c_str());
         std::fflush(stdout);

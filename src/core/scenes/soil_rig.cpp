@@ -48,7 +48,8 @@ void RigCheckpoints::AfterStep(const SoilRig& rig, bool now) {
   id_.step = rig.dem().step_count();
   id_.time = rig.dem().time();
   try {
-    WriteCheckpointFile(o_.file, id_, [&rig](StateWriter& w) { rig.SaveState(w); });
+    last_bytes_ = WriteCheckpointFile(o_.file, id_, [&rig](StateWriter& w) { rig.SaveState(w); });
+    last_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
     ++written_;
     written_at_ = id_.time;
   } catch (const ConfigError& e) {  // (the run goes on; its result says the checkpoint failed)

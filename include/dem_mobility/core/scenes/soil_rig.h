@@ -4,6 +4,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -83,6 +84,10 @@ class RigCheckpoints {
   /// kept or removed. Returns a line for a console ("" none).
   std::string Settle(const SoilRig& rig, ResultFile* f);
   int written() const { return written_; }
+  /// The last checkpoint written: its size [bytes], how long the writing took [s], the rig's time in it [s].
+  uint64_t last_bytes() const { return last_bytes_; }
+  double last_seconds() const { return last_seconds_; }
+  double last_time() const { return written_at_; }
   const std::string& error() const { return error_; }
   bool restarted() const { return !o_.restart_file.empty(); }
   const CheckpointIdentity& identity() const { return id_; }
@@ -93,6 +98,8 @@ class RigCheckpoints {
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
   int written_ = 0;
   double written_at_ = 0.0;  ///< [s] the rig's time in the last checkpoint written
+  uint64_t last_bytes_ = 0;
+  double last_seconds_ = 0.0;
   std::string error_;
 };
 
