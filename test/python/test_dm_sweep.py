@@ -154,6 +154,15 @@ class Grid(unittest.TestCase):
 
 
 class Pool(Base):
+    def test_a_run_that_ends_is_seen_at_once_not_at_the_next_poll(self):
+        # (SIGCHLD wakes the pool: three runs one after the other at a 5 s poll end in far less
+        # than the 15 s three polls would take)
+        t0 = time.time()
+        s = self.sweep(dm_sweep.grid([('x', [1, 2, 3])]), jobs=1, poll=5.0)
+        s.run()
+        self.assertEqual(s.exit_status(), 0, self.out.getvalue())
+        self.assertLess(time.time() - t0, 10.0)
+
     def test_failures_reported_others_kept(self):
         cases = dm_sweep.cases([{'mode': 'ok', 'x': 1}, {'mode': 'fail', 'x': 2}, {'mode': 'hang', 'x': 3},
                                 {'mode': 'crash', 'x': 4}, {'mode': 'ok', 'x': 5}])

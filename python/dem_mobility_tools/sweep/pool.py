@@ -326,11 +326,16 @@ class Sweep:
         as a batch system or `kill` sends it) terminates the running runs (their error says
         'interrupted') and raises KeyboardInterrupt."""
         self.t0 = time.time() if t0 is None else t0
-        restore = None
+        restore = restore_chld = None
+        # a run's end wakes the pool at once (SIGCHLD) rather than at its next poll; the poll
+        # remains for the timeouts and the status lines (and off the main thread, where no
+        # signal handler can be set)
+        wake = threading.Event()
         if threading.current_thread() is threading.main_thread():
             def terminated(signum, frame):
                 raise KeyboardInterrupt('SIGTERM')
             restore = signal.signal(signal.SIGTERM, terminated)
+            restore_chld = signal.signal(signal.SIGCHLD, lambda signum, frame: wake.set())
         pending = [o for o in self.outcomes if not o.done]
         running = []
         finished = len(self.outcomes) - len(pending)
@@ -349,7 +354,8 @@ class Sweep:
                     running.append(o)  # before it starts: a signal inside _launch must find it
                     self._launch(o)
                     self.line('[%6.0f s] start  %-14s (port %d)' % (time.time() - self.t0, o.name, o.port))
-                time.sleep(self.poll)
+                wake.wait(self.poll)
+                wake.clear()  # (before the look: a run that ends after it sets it again)
                 for o in list(running):
                     alive = o.proc is not None and o.proc.poll() is None
                     late = self.timeout is not None and time.time() - o.start > self.timeout
@@ -404,6 +410,8 @@ class Sweep:
             self._progress = None
             if restore is not None:
                 signal.signal(signal.SIGTERM, restore)
+            if restore_chld is not None:
+                signal.signal(signal.SIGCHLD, restore_chld)
         return self.outcomes
 
     # -- the outcome
