@@ -3,6 +3,7 @@ with its own ROS master port, a timeout and its console output in a log file; a 
 read from the result YAML it writes; resume keeps the cases whose result is already good."""
 import os
 import re
+import select
 import signal
 import threading
 import subprocess
@@ -29,6 +30,50 @@ def last_progress(log, marker='progress:'):
         if k >= 0:
             return re.sub(r'\x1b\[[0-9;]*m', '', line[k + len(marker):]).strip()
     return 'starting'
+
+
+class _Wake:
+    """The pool's pause between looks at its runs: up to `poll` seconds, cut short when a child
+    process ends. On the main thread SIGCHLD is routed to a pipe (signal.set_wakeup_fd: written by
+    the interpreter itself, so the handler takes no lock a signal could interrupt) that the pause
+    selects on; elsewhere, a plain sleep."""
+
+    def __init__(self, poll):
+        self.poll = poll
+        self.fds = None
+        if threading.current_thread() is not threading.main_thread():
+            return
+        r, w = os.pipe()
+        os.set_blocking(r, False)
+        os.set_blocking(w, False)
+        try:
+            self.old_fd = signal.set_wakeup_fd(w)
+        except ValueError:
+            os.close(r)
+            os.close(w)
+            return
+        self.old_chld = signal.signal(signal.SIGCHLD, lambda signum, frame: None)
+        self.fds = (r, w)
+
+    def nap(self):
+        if self.fds is None:
+            time.sleep(self.poll)
+            return
+        select.select([self.fds[0]], [], [], self.poll)
+        try:  # (drained before the look at the runs: a run that ends after it writes again)
+            while os.read(self.fds[0], 512):
+                pass
+        except BlockingIOError:
+            pass
+
+    def close(self):
+        if self.fds is None:
+            return
+        signal.signal(signal.SIGCHLD, self.old_chld)
+        signal.set_wakeup_fd(self.old_fd)
+        for fd in self.fds:
+            os.close(fd)
+        self.fds = None
 
 
 class Outcome:
@@ -326,16 +371,12 @@ class Sweep:
         as a batch system or `kill` sends it) terminates the running runs (their error says
         'interrupted') and raises KeyboardInterrupt."""
         self.t0 = time.time() if t0 is None else t0
-        restore = restore_chld = None
-        # a run's end wakes the pool at once (SIGCHLD) rather than at its next poll; the poll
-        # remains for the timeouts and the status lines (and off the main thread, where no
-        # signal handler can be set)
-        wake = threading.Event()
+        restore = None
         if threading.current_thread() is threading.main_thread():
             def terminated(signum, frame):
                 raise KeyboardInterrupt('SIGTERM')
             restore = signal.signal(signal.SIGTERM, terminated)
-            restore_chld = signal.signal(signal.SIGCHLD, lambda signum, frame: wake.set())
+        wake = _Wake(self.poll)
         pending = [o for o in self.outcomes if not o.done]
         running = []
         finished = len(self.outcomes) - len(pending)
@@ -354,8 +395,7 @@ class Sweep:
                     running.append(o)  # before it starts: a signal inside _launch must find it
                     self._launch(o)
                     self.line('[%6.0f s] start  %-14s (port %d)' % (time.time() - self.t0, o.name, o.port))
-                wake.wait(self.poll)
-                wake.clear()  # (before the look: a run that ends after it sets it again)
+                wake.nap()
                 for o in list(running):
                     alive = o.proc is not None and o.proc.poll() is None
                     late = self.timeout is not None and time.time() - o.start > self.timeout
@@ -410,8 +450,7 @@ class Sweep:
             self._progress = None
             if restore is not None:
                 signal.signal(signal.SIGTERM, restore)
-            if restore_chld is not None:
-                signal.signal(signal.SIGCHLD, restore_chld)
+            wake.close()
         return self.outcomes
 
     # -- the outcome
