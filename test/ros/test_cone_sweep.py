@@ -132,6 +132,28 @@ class ConeSweep(unittest.TestCase):
         self.assertEqual(again['cone_index_psi'], swept['cone_index_psi'])  # bit for bit
         self.assertFalse(os.path.exists(ck))
 
+    def test_the_rig_launch_files_put_overrides_among_the_scene_keys(self):
+        # overrides:= (dm-calibrate --set) lands where the rig reads its scene's overrides, beside
+        # the named ones, in both rig launch files; without it, nothing more is set
+        for launch, ns, yaml_map, want in (
+                ('cone_penetrometer.launch', 'cone', '{levels: {tiny: {container_diameter: 0.9}}, seed: 2}',
+                 {'/cone/override/levels/tiny/container_diameter': 0.9, '/cone/override/seed': 2}),
+                ('single_wheel.launch', 'wheel', '{carriage: {damping: 2000}}',
+                 {'/wheel/override/carriage/damping': 2000})):
+            for given in (yaml_map, None):
+                args = ['roslaunch', '--dump-params', 'dem_mobility', launch] + (['overrides:=' + given] if given else [])
+                out = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
+                                     timeout=60)
+                self.assertEqual(out.returncode, 0, out.stdout)
+                params = yaml.safe_load(out.stdout)
+                for key, value in want.items():
+                    if given:
+                        self.assertEqual(params.get(key), value, (launch, key, out.stdout))
+                    elif key.endswith('/seed'):
+                        self.assertEqual(params.get(key), '', launch)  # (the named argument's empty default)
+                    else:
+                        self.assertNotIn(key, params, launch)
+
 
 if __name__ == '__main__':
     unittest.main()
