@@ -410,8 +410,7 @@ void ConePenetrometer::Io(Ar& ar) {
      samples_, wall);
   if constexpr (Ar::kLoading) {
     if (static_cast<int>(phase_) < 0 || phase_ > Phase::kDone) ar.Fail("the cone's phase is not one");
-    wall0_ = std::chrono::steady_clock::now() -
-             std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wall));
+    wall0_ = WallClockStartFor(wall);
   }
 }
 

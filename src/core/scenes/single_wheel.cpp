@@ -165,8 +165,7 @@ void SingleWheelRig::Io(Ar& ar) {
      s_sink_, s_omega_, s_t0_, s_x0_, s_n_, rest_fz_, rest_sink_, rest_n_, samples_, prep_wall_time_, wall);
   if constexpr (Ar::kLoading) {
     if (static_cast<int>(phase_) < 0 || phase_ > Phase::kDone) ar.Fail("the wheel rig's phase is not one");
-    wall0_ = std::chrono::steady_clock::now() -
-             std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wall));
+    wall0_ = WallClockStartFor(wall);
   }
 }
 

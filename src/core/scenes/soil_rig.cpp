@@ -21,6 +21,11 @@ void RunSoilRig(SoilRig& rig, const std::function<void(const SoilRig&)>& progres
   }
 }
 
+std::chrono::steady_clock::time_point WallClockStartFor(double so_far) {
+  return std::chrono::steady_clock::now() -
+         std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(so_far));
+}
+
 std::unique_ptr<SoilRig> RigCheckpoints::Start(const YamlReader& scene) {
   const std::string scene_file = o_.scene_file.empty() ? scene.file() : o_.scene_file;
   // what the checkpoints record: the scene, then every input file the rig reads (soil, table)

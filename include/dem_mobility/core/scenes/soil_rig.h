@@ -52,6 +52,10 @@ class SoilRig {
 /// failed (Fail) with what was measured so far.
 void RunSoilRig(SoilRig& rig, const std::function<void(const SoilRig&)>& progress = nullptr, long every = 1000);
 
+/// The start of a rig's wall clock that makes its wall time `so_far` seconds now: a rig taken up
+/// from a checkpoint goes on counting from the wall time the checkpoint holds.
+std::chrono::steady_clock::time_point WallClockStartFor(double so_far);
+
 /// Where a rig run keeps its checkpoint, and whether it is taken up from one.
 struct RigCheckpointOptions {
   std::string file;          ///< the checkpoint ("" none)
