@@ -44,11 +44,11 @@ std::unique_ptr<SoilRig> RigCheckpoints::Start(const YamlReader& scene) {
 
 void RigCheckpoints::AfterStep(const SoilRig& rig, bool now) {
   if (o_.file.empty()) return;
-  const auto t = std::chrono::steady_clock::now();
   const bool first = written_ == 0 && error_.empty() && !restarted();
-  if (!now && !first &&
-      ((rig.dem().step_count() & 255) != 0 || std::chrono::duration<double>(t - last_).count() < o_.every))
-    return;
+  // (the clock is read every 256 steps only: this runs after every step)
+  if (!now && !first && (rig.dem().step_count() & 255) != 0) return;
+  const auto t = std::chrono::steady_clock::now();
+  if (!now && !first && std::chrono::duration<double>(t - last_).count() < o_.every) return;
   last_ = t;
   id_.step = rig.dem().step_count();
   id_.time = rig.dem().time();
