@@ -95,7 +95,7 @@ TEST(ConeConfig, ConeIndexTurnsIntoFThroughTheTable) {
 // A level whose particles no table was made for: the cone index is refused, naming the key and
 // both sizes (the level's and the tables').
 TEST(ConeConfig, ConeIndexRefusedWithoutATableForTheLevelsParticles) {
-  ExpectRefused({"fidelity=medium", "cone_index=100"}, {"cone_index", "particle_diameter", "0.05", "0.06"});
+  ExpectRefused({"fidelity=fine", "cone_index=100"}, {"cone_index", "particle_diameter", "0.04", "0.06"});
   ExpectRefused({"friction=0.3", "cone_index=100"}, {"cone_index", "friction 0.3", "mu 0.1"});
 }
 

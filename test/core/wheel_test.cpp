@@ -345,13 +345,13 @@ TEST(SingleWheelConfig, UsesTheCalibrationTableOfItsParticleSizeOnly) {
   ASSERT_TRUE(tiny.bin.strength.calibration);
   EXPECT_DOUBLE_EQ(tiny.bin.strength.calibration->particle_diameter, 0.1);
   EXPECT_DOUBLE_EQ(tiny.bin.strength.cohesion_factor, tiny.bin.strength.calibration->CohesionFactor(100.0));
-  // medium (0.05 m): no table is made at that size; a cone index is refused, f runs with its CI unknown
-  ExpectRefused({"fidelity=medium", "cone_index=100"}, "particle_diameter");
-  const SingleWheelParams medium =
-      SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"fidelity=medium", "cohesion_factor=2"}));
-  EXPECT_FALSE(medium.bin.strength.calibration);
-  EXPECT_FALSE(std::isfinite(medium.bin.strength.ConeIndex()));
-  EXPECT_NE(medium.bin.strength.no_table_reason.find("0.05"), std::string::npos) << medium.bin.strength.no_table_reason;
+  // fine (0.04 m): no table is made at that size; a cone index is refused, f runs with its CI unknown
+  ExpectRefused({"fidelity=fine", "cone_index=100"}, "particle_diameter");
+  const SingleWheelParams fine =
+      SingleWheelParams::Read(YamlReader::LoadWithOverrides(SceneFile(), {"fidelity=fine", "cohesion_factor=2"}));
+  EXPECT_FALSE(fine.bin.strength.calibration);
+  EXPECT_FALSE(std::isfinite(fine.bin.strength.ConeIndex()));
+  EXPECT_NE(fine.bin.strength.no_table_reason.find("0.04"), std::string::npos) << fine.bin.strength.no_table_reason;
 }
 
 TEST(SingleWheelRig, ALoadTheSoilCannotCarryIsReportedSunk) {
