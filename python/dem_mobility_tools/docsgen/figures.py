@@ -4,10 +4,11 @@
 |------------------------------------------------|-------------------------------------------------------|
 | vehicle-on-soil-study.png                      | docs/vehicle-on-soil-study.yaml                       |
 | cone-ci-vs-f-sizes.png                         | config/calibration/cone_index_mu0.1_d*.yaml           |
-| cone-ci-vs-f-d0.06.png, cone-ci-vs-f-d0.1.png  | config/calibration/cone_index_mu0.1_d*.yaml           |
+| cone-ci-vs-f-dD.png (one per table)            | config/calibration/cone_index_mu0.1_dD.yaml           |
 | single-wheel-{dp,torque,sinkage}-vs-slip.png   | docs/data/single-wheel-slip-sweep.yaml                |
 | single-wheel-calibrated-dp-vs-slip.png         | docs/data/single-wheel-calibrated.yaml                |
 """
+import glob
 import os
 import re
 
@@ -79,7 +80,6 @@ def cone_table(root, table_rel, png_name, title):
 def cone_sizes(root):
     """Every installed mu 0.1 table on one axis: the mean CI per f with its std over the seeds and
     the table, one colour per particle size, beside the paper's table 3."""
-    import glob
     tables = []
     for path in glob.glob(os.path.join(root, 'config', 'calibration', 'cone_index_mu0.1_d*.yaml')):
         t = _load(root, os.path.relpath(path, root))
@@ -211,9 +211,9 @@ def wheel_calibrated(root):
 
 def draw_all(root):
     """Redraws every plot; returns their paths."""
-    out = [fidelity_study(root), cone_sizes(root),
-           cone_table(root, 'config/calibration/cone_index_mu0.1_d0.06.yaml', 'cone-ci-vs-f-d0.06.png',
-                      'CI versus f at 0.1 m/s, 0.06 m particles, mu 0.1'),
-           cone_table(root, 'config/calibration/cone_index_mu0.1_d0.1.yaml', 'cone-ci-vs-f-d0.1.png',
-                      'CI versus f at 0.1 m/s, 0.1 m particles, mu 0.1')]
+    out = [fidelity_study(root), cone_sizes(root)]
+    for path in sorted(glob.glob(os.path.join(root, 'config', 'calibration', 'cone_index_mu0.1_d*.yaml'))):
+        d = os.path.basename(path)[len('cone_index_mu0.1_d'):-len('.yaml')]
+        out.append(cone_table(root, os.path.relpath(path, root), 'cone-ci-vs-f-d{}.png'.format(d),
+                              'CI versus f at 0.1 m/s, {} m particles, mu 0.1'.format(d)))
     return out + wheel_sweep(root) + [wheel_calibrated(root)]
