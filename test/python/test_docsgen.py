@@ -225,6 +225,38 @@ class ConeData(RepoCopy):
         self.assertEqual([r['time_step'] for r in s['rows']], ['8e-05', '6e-05'])
 
 
+    def test_f_per_paper_ci_per_size(self):
+        import yaml
+        from dem_mobility_tools.docsgen import cone_data, make
+        folder = os.path.join(self.tmp, 'tables')
+        os.makedirs(folder)
+
+        def table(d, rows):
+            t = {'particle_diameter': d, 'friction': 0.1, 'fidelity': 'd%g_cal' % d, 'table': rows, 'runs': {},
+                 'points': {}, 'provenance': {'commit': 'abcdef123', 'date': '2026-12-07'}}
+            with open(os.path.join(folder, 'cone_index_mu0.1_d%g.yaml' % d), 'w') as f:
+                yaml.safe_dump(t, f)
+        # reaches from below 30 to 150 psi (rows at table 3's CIs inside); the other starts above 30
+        table(0.1, [[25.0, 0.05], [30.0, 0.0787], [40.0, 0.2], [50.0, 0.35], [60.0, 0.6], [70.0, 0.9], [80.0, 1.1],
+                    [100.0, 1.5], [120.0, 1.9], [150.0, 2.5], [160.0, 2.8]])
+        table(0.07, [[33.0, 0.05], [40.0, 0.16], [50.0, 0.5], [60.0, 1.0], [70.0, 1.3], [80.0, 1.5], [100.0, 1.9],
+                     [120.0, 2.3], [150.0, 2.9], [200.0, 4.1], [242.0, 5.25], [300.0, 7.0]])
+        with open(cone_data.write_sizes(self.tmp, folder, 'a test machine')) as f:
+            s = yaml.safe_load(f)
+        self.assertEqual(s['table'], 'cone/sizes')
+        self.assertEqual([r['source'] for r in s['rows']],
+                         ['paper (0.03 m, table 3)', '0.07 m (`d0.07_cal`)', '0.1 m (`d0.1_cal`)'])
+        paper, d07, d1 = s['rows']
+        self.assertEqual((paper['ci_30'], paper['ci_242']), ('0.06', '12.1'))
+        self.assertEqual(d07['ci_30'], '— (33.0 at f 0.05)')   # below the table's least CI
+        self.assertEqual(d07['ci_242'], '5.25')
+        self.assertEqual(d1['ci_30'], '0.079')
+        self.assertEqual(d1['ci_200'], '— (160.0 at f 2.8)')   # above its largest
+        # a CI inside the range without its row is an error, not a guess
+        table(0.1, [[25.0, 0.05], [40.0, 0.2], [160.0, 2.8]])
+        with self.assertRaises(make.DocsError):
+            cone_data.write_sizes(self.tmp, folder, 'a test machine')
+
 class WheelData(RepoCopy):
     """dm-docs-wheel: the kept runs of a calibrated-wheel sweep become a row per CI and case, with
     the references of wheel_numerics at the same CI, tire and load, and the seeds' mean and std."""

@@ -1,6 +1,7 @@
 """dm-docs-cone: writes the docs' data files of one cone index table (docs/data/cone-seeds-dD.yaml
 and cone-table-dD.yaml) from the table dm-calibrate installed, for dm-docs to render; with
---tables, the overview of every table installed (docs/data/cone-tables.yaml).
+--tables, the overview of every table installed (docs/data/cone-tables.yaml) and f per CI of the
+paper's table 3 at every size (docs/data/cone-sizes.yaml).
 
     dm-docs-cone config/calibration/cone_index_mu0.1_d0.06.yaml --machine "..." [--beside TABLE ...]
     dm-docs-cone --tables config/calibration --machine "..."
@@ -184,11 +185,66 @@ def write_overview(root, folder, machine, soil_law=None):
     return write_data(root, 'cone-tables.yaml', data, soil_law)
 
 
+def _f_text(f):
+    return '{:.2f}'.format(f) if f >= 0.1 else '{:.2g}'.format(f)
+
+
+def size_row(t, cis):
+    """f per CI of `cis` from a table's rows (the sweep writes a row at each of table 3's CIs inside
+    its range); outside the range, what the table reaches instead."""
+    rows = t['table']
+    out = {}
+    for c in cis:
+        lo, hi = rows[0], rows[-1]
+        if c < lo[0]:
+            out['ci_{:g}'.format(c)] = '— ({:.1f} at f {:g})'.format(lo[0], lo[1])
+        elif c > hi[0]:
+            out['ci_{:g}'.format(c)] = '— ({:.1f} at f {:g})'.format(hi[0], hi[1])
+        else:
+            at = [f for ci, f in rows if abs(ci - c) < 1e-9]
+            if not at:
+                raise DocsError('the table for d = {:g} m has no row at CI {:g}'.format(t['particle_diameter'], c))
+            out['ci_{:g}'.format(c)] = _f_text(at[0])
+    return out
+
+
+def write_sizes(root, folder, machine, soil_law=None):
+    """docs/data/cone-sizes.yaml: f per CI of the paper's table 3, the paper's row and one per mu 0.1
+    table in `folder` (by particle size)."""
+    import glob
+    from ..calibration.cone_index import PAPER_TABLE
+    tables = [_load(p) for p in sorted(glob.glob(os.path.join(folder, 'cone_index_mu0.1_d*.yaml')))]
+    if not tables:
+        raise DocsError('{}: no cone_index_mu0.1_d*.yaml'.format(folder))
+    tables.sort(key=lambda t: t['particle_diameter'])
+    cis = [c for c, _ in PAPER_TABLE]
+    rows = [dict({'source': 'paper (0.03 m, table 3)'}, **{'ci_{:g}'.format(c): '{:g}'.format(f) for c, f in PAPER_TABLE})]
+    for t in tables:
+        rows.append(dict({'source': '{:g} m (`{}`)'.format(t['particle_diameter'], t['fidelity'])}, **size_row(t, cis)))
+    data = {
+        'table': 'cone/sizes',
+        'doc': 'cone-penetrometer.md',
+        'provenance': {
+            'commit': ', '.join(sorted({str(t['provenance'].get('commit', '?'))[:7] for t in tables})) +
+                      " (the tables' provenance)",
+            'machine': machine,
+            'date': ', '.join(sorted({str(t['provenance'].get('date', '?')) for t in tables})),
+            'command': 'dm-calibrate --fidelity LEVEL ... --install config/calibration',
+            'recorded_in': '{}/cone_index_mu0.1_d*.yaml (their rows at table 3\'s CIs); the paper\'s table 3'.format(
+                os.path.relpath(os.path.abspath(folder), root)),
+        },
+        'columns': [{'key': 'source', 'title': 'CI [psi]'}] + [{'key': 'ci_{:g}'.format(c), 'title': '{:g}'.format(c)}
+                                                             for c in cis],
+        'rows': rows,
+    }
+    return write_data(root, 'cone-sizes.yaml', data, soil_law)
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(prog='dm-docs-cone', description=__doc__.split('\n')[0])
     p.add_argument('table', nargs='?', help='a table dm-calibrate installed (config/calibration/cone_index_mu*_d*.yaml)')
     p.add_argument('--tables', metavar='FOLDER', default=None,
-                   help='write the overview of every table in FOLDER instead (docs/data/cone-tables.yaml)')
+                   help='write the overview of every table in FOLDER instead (docs/data/cone-tables.yaml) and f per paper CI per size (docs/data/cone-sizes.yaml)')
     p.add_argument('--machine', required=True, help='the machine the runs were made on')
     p.add_argument('--command', default=None, help='the command that made the table (default: its provenance\'s)')
     p.add_argument('--conditions', default=None, help='how the runs were made (one line)')
@@ -201,6 +257,7 @@ def main(argv=None):
     try:
         if a.tables:
             print(os.path.relpath(write_overview(root, a.tables, a.machine, a.soil_law), root))
+            print(os.path.relpath(write_sizes(root, a.tables, a.machine, a.soil_law), root))
             return 0
         if not a.table:
             raise DocsError('name a table, or --tables FOLDER')
