@@ -297,6 +297,30 @@ TEST(CiCalibration, InstalledTablesCarryTheirParticleSize) {
   EXPECT_GT(tables, 0);
 }
 
+// Every installed table is measured over table 3's strong end the way the issue of the tables asks:
+// at least 7 f values, 3 seeds at each (the paper size: 3 seeds at two f, one elsewhere), the mean CI
+// rising with f at every point, and a measured point at or above table 3's 242 psi. (The weak end,
+// a point at or below 30 psi, is not met at 0.06 m: docs/cone-penetrometer.md.)
+TEST(CiCalibration, InstalledTablesRiseWithFAndReachTable3sStrongestSoil) {
+  for (const auto& e : std::filesystem::directory_iterator(DM_CONFIG_DIR "/calibration")) {
+    if (e.path().extension() != ".yaml") continue;
+    const CiCalibration c = CiCalibration::Load(e.path().string());
+    ASSERT_GE(c.points.size(), 7u) << c.file;
+    int three = 0;
+    for (size_t k = 0; k < c.points.size(); ++k) {
+      if (c.points[k].seeds >= 3) ++three;
+      if (k == 0) continue;
+      EXPECT_GT(c.points[k].f, c.points[k - 1].f) << c.file;
+      EXPECT_GT(c.points[k].ci_mean, c.points[k - 1].ci_mean) << c.file << ", f = " << c.points[k].f;
+    }
+    if (c.level == "paper_cal")
+      EXPECT_GE(three, 2) << c.file;
+    else
+      EXPECT_EQ(three, static_cast<int>(c.points.size())) << c.file;
+    EXPECT_GE(c.points.back().ci_mean, 242.0) << c.file;
+  }
+}
+
 TEST(DemShapes, ContainerFacetsAndConeMatchTheirGeometry) {
   const double R = 0.6, L = 0.7, rb = 0.1875;
   for (const DemWall& w : MakeCylinderSideWalls("c", R, 1.0, 24)) {
