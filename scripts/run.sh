@@ -8,8 +8,8 @@
 #   ./scripts/run.sh grade:=20 cone_index:=60        the same with other launch arguments
 #   ./scripts/run.sh road [grade:=12 duration:=20]   the road scene (road_slope.launch)
 source "$(dirname "$0")/lib.sh"
-# the soil's level for the main job (coarse or tiny: the levels with a cone index calibration
-# table; paper, fine and medium have none yet); fidelity:=... overrides it
+# the soil's level for the main job (coarse by default; medium, coarse and tiny have a cone index
+# calibration table, paper and fine none yet); fidelity:=... overrides it
 SOIL_FIDELITY="${DM_SOIL_FIDELITY:-coarse}"
 
 scene=soil_slope
