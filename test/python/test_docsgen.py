@@ -336,12 +336,15 @@ class ConeSetupData(RepoCopy):
                 yaml.safe_dump(dict(self.RUN, cohesion_factor=f_, seed=seed, cone_index_psi=ci), f)
         return folder
 
+    SETUP = {'container_diameter': 1.2, 'soil_depth': 1.6, 'cone_speed': 0.1, 'ci_window': [0.78, 0.92]}
+
     def test_rows_against_the_same_seed(self):
         import yaml
         from dem_mobility_tools.docsgen import cone_setup
-        table = self.kept('table', {(1, 1): 60.0, (1, 2): 66.0, (1, 3): 63.0, (5, 1): 230.0, (5, 2): 240.0}, {})
+        table = self.kept('table', {(1, 1): 60.0, (1, 2): 66.0, (1, 3): 63.0, (5, 1): 230.0, (5, 2): 240.0},
+                          {'conditions': self.SETUP})
         wide = self.kept('wide', {(1, 1): 63.0, (5, 1): 220.0, (5, 2): 252.0},
-                         {'--set': ['levels.coarse_cal.container_diameter=2.0']})
+                         {'conditions': self.SETUP, '--set': ['levels.coarse_cal.container_diameter=2.0']})
         with open(cone_setup.write(self.tmp, table, [wide], 'a test machine')) as f:
             t = yaml.safe_load(f)
         self.assertEqual(t['table'], 'cone/setup_d0.06')
@@ -352,9 +355,20 @@ class ConeSetupData(RepoCopy):
                           (5, '1, 2', 236.0, '+0.4 %')])
         self.assertEqual(r[1]['what'], 'container 2.0 m (1.2)')
         self.assertEqual(r[0]['seed_scatter'], '3.0 (4.8 %; 3 seeds: 60.0, 66.0, 63.0)')
-        # a seed the table does not hold, a folder of no set-up, another level: refused, naming it
+        # another table's runs of the level, made in another set-up (no --set): what differs is named,
+        # the table's value in brackets; the block's name as asked
+        older = self.kept('older', {(1, 1): 57.0}, {'conditions': dict(self.SETUP, container_diameter=2.0,
+                                                                           ci_window=[0.78, 1.0])})
+        path = cone_setup.write(self.tmp, table, [older], 'm', name='setup_d0.06_before')
+        self.assertTrue(path.endswith('cone-setup-d0.06-before.yaml'), path)
+        with open(path) as f:
+            t = yaml.safe_load(f)
+        self.assertEqual(t['table'], 'cone/setup_d0.06_before')
+        self.assertEqual(t['rows'][1]['what'], 'CI window 0.78-1.0 m (0.78-0.92); container 2.0 m (1.2)')
+        self.assertEqual(t['rows'][1]['change'], '-5.0 %')
+        # a seed the table does not hold, a folder of the table's own set-up, another level: refused, naming it
         for bad, said in ((self.kept('s9', {(1, 9): 60.0}, {'--set': ['seed_x=1']}), 'seed 9'),
-                          (self.kept('plain', {(1, 1): 60.0}, {}), 'no --set'),
+                          (self.kept('plain', {(1, 1): 60.0}, {'conditions': self.SETUP}), 'set-up of the table'),
                           (self.kept('other', {(1, 1): 60.0}, {'--fidelity': 'tiny_cal', '--set': ['a=1']}), 'tiny_cal')):
             with self.assertRaises(make.DocsError) as e:
                 cone_setup.write(self.tmp, table, [bad], 'm')

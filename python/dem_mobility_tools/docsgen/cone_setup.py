@@ -1,18 +1,22 @@
 """dm-docs-cone-setup: writes the docs' data file of a cone set-up study (docs/data/cone-setup-dD.yaml) from
 the runs dm-calibrate kept: the table's own runs at a level (its --keep folder) and, for each set-up
-knob, a folder of runs made with `--no-table --set KEY=VALUE`, for dm-docs to render.
+knob, a folder of runs made with `--no-table --set KEY=VALUE` (or the runs of another table of the
+level made in another set-up), for dm-docs to render.
 
-    dm-docs-cone-setup config/calibration/runs/coarse_cal docs/data/cone-setup-runs/coarse_cal_container2.0 \\
-        [more set-up folders] --machine "..."
+    dm-docs-cone-setup config/calibration/runs/coarse_cal docs/data/cone-setup-runs/coarse_cal_container2.4 \\
+        [more set-up folders] --machine "..." [--name setup_d0.06]
 
-Per f of the set-up runs: the table's run of each seed (its CI, and the std over the table's seeds at
-that f), then each knob's run of the same f and seed, its CI and its change against the table's run of
-that seed; a knob run at several seeds gets a row of the means too. A change is only read against the
-table's run of the same seed: the seeds' own scatter is in the table's row.
+What a folder changed is read from its sweep options (the level's conditions, with its --set applied)
+against the table folder's: each key that differs, the table's value in brackets. Per f of the
+set-up runs: the table's run of each seed (its CI, and the std over the table's seeds at that f), then
+each knob's run of the same f and seed, its CI and its change against the table's run of that seed; a
+knob run at several seeds gets a row of the means too. A change is only read against the table's run
+of the same seed: the seeds' own scatter is in the table's row.
 """
 import argparse
 import glob
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -25,7 +29,9 @@ COLUMNS = (('what', 'set-up'), ('f', 'f'), ('seeds', 'seeds'), ('ci', 'CI [psi]'
            ('seed_scatter', 'std over seeds [psi]'))
 # the set-up's values a cone result names (so that a row can say what the table's was)
 RESULT_KEYS = {'container_diameter': ('container', 'm'), 'soil_depth': ('soil poured', 'm deep'),
-               'cone_speed': ('cone at', 'm/s'), 'ci_window': ('CI window', 'm')}
+               'cone_speed': ('cone at', 'm/s'), 'ci_window': ('CI window', 'm'), 'time_step': ('time step', 's'),
+               'approach_speed': ('approach at', 'm/s'), 'approach_depth': ('approach down to', 'm'),
+               'settle_time': ('settled for', 's'), 'hold_time': ('lid held for', 's')}
 
 
 def _runs(folder):
@@ -68,18 +74,36 @@ def _pct(x):
     return '{:+.1f} %'.format(100.0 * x)
 
 
-def _knob(settings, table_run):
-    """What a set-up folder changed, in words, with the table's value in brackets where its result names it."""
-    words = []
-    for s in settings:
+def _effective(options):
+    """The set-up a kept folder's runs were made in: its level's conditions with its --set applied
+    ({key: value}; a --set of the level's own key goes by that key, any other by its dotted key)."""
+    level = options.get('--fidelity')
+    cond = dict(options.get('conditions') or {})
+    for s in options.get('--set') or []:
         key, _, value = s.partition('=')
-        name = key.split('.')[-1]
-        if name in RESULT_KEYS:
-            title, unit = RESULT_KEYS[name]
-            was = table_run.get(name)
-            words.append('{} {} {}{}'.format(title, value, unit, ' ({})'.format(was) if was is not None else ''))
-        else:
-            words.append('{} = {}'.format(key, value))
+        prefix = 'levels.{}.'.format(level)
+        cond[key[len(prefix):] if key.startswith(prefix) else key] = yaml.safe_load(value)
+    return cond
+
+
+def _value(v):
+    if isinstance(v, (list, tuple)):
+        return '-'.join(_value(x) for x in v)
+    if isinstance(v, float) and v != 0 and abs(v) < 1e-3:
+        return '{:g}'.format(v)
+    return str(v)
+
+
+def _knob(mine, table):
+    """What a set-up changed against the table's, in words ('container 2.4 m (2)'), or '' if nothing."""
+    words = []
+    for key in sorted(set(mine) | set(table)):
+        a, b = mine.get(key), table.get(key)
+        if a == b:
+            continue
+        title, unit = RESULT_KEYS.get(key, (key, ''))
+        words.append('{} {}{} ({})'.format(title, _value(a) if a is not None else '—', ' ' + unit if unit else '',
+                                           _value(b) if b is not None else '—'))
     return '; '.join(words)
 
 
@@ -123,24 +147,26 @@ def rows(table_runs, knobs):
     return out
 
 
-def write(root, table_folder, folders, machine, soil_law=None):
-    """Writes docs/data/cone-setup-dD.yaml; returns its path."""
+def write(root, table_folder, folders, machine, soil_law=None, name=None):
+    """Writes docs/data/cone-NAME.yaml (NAME: setup-dD unless given, '_' read as '-'); returns its path."""
     table_runs, table_options = _runs(table_folder)
     d = float(next(iter(table_runs.values()))['particle_diameter'])
     level = table_options.get('--fidelity')
+    table_setup = _effective(table_options)
     knobs, commits = [], set()
     for folder in folders:
         runs, options = _runs(folder)
         if options.get('--fidelity') != level:
             raise DocsError('{}: runs at level {}, not the table\'s {}'.format(folder, options.get('--fidelity'), level))
-        settings = options.get('--set') or []
-        if not settings:
-            raise DocsError('{}: made with no --set: not a set-up study\'s runs'.format(folder))
-        knobs.append((_knob(settings, next(iter(table_runs.values()))), runs, settings))
+        what = _knob(_effective(options), table_setup)
+        if not what:
+            raise DocsError('{}: made in the set-up of the table\'s runs ({}): not a set-up study\'s runs'.format(
+                folder, table_folder))
+        knobs.append((what, runs, options.get('--set') or []))
         commits |= {str(r.get('kept_from_commit', '?')) for r in runs.values()}
-    name = 'cone-setup-d{:g}.yaml'.format(d)
+    name = name or 'setup_d{:g}'.format(d)
     data = {
-        'table': 'cone/setup_d{:g}'.format(d), 'doc': 'cone-penetrometer.md',
+        'table': 'cone/' + name, 'doc': 'cone-penetrometer.md',
         'provenance': {
             'commit': ', '.join(sorted(commits)) + ' (the builds the set-up runs were made with)',
             'machine': machine,
@@ -153,7 +179,7 @@ def write(root, table_folder, folders, machine, soil_law=None):
         'rows': rows(table_runs, knobs)}
     if data['provenance']['date'] is None:
         del data['provenance']['date']
-    return write_data(root, name, data, soil_law)
+    return write_data(root, 'cone-{}.yaml'.format(name.replace('_', '-')), data, soil_law)
 
 
 def main(argv=None):
@@ -162,11 +188,15 @@ def main(argv=None):
     p.add_argument('setup_runs', nargs='+', help='folders of set-up runs (dm-calibrate --no-table --set ... --keep)')
     p.add_argument('--machine', required=True, help='the machine the runs were made on')
     p.add_argument('--soil-law', default=None, help='the reading of the soil law the runs were made with (one line)')
+    p.add_argument('--name', default=None,
+                   help="the generated block's name, cone/NAME (default setup_dD; its data file docs/data/cone-NAME.yaml)")
     p.add_argument('--root', default=None, help='the checkout (default: the working folder)')
     a = p.parse_args(argv)
     root = a.root or default_root()
+    if a.name is not None and not re.fullmatch(r'[a-z0-9_.]+', a.name):
+        p.error('--name {!r}: lower-case letters, digits, _ and . only'.format(a.name))
     try:
-        print(os.path.relpath(write(root, a.table_runs, a.setup_runs, a.machine, a.soil_law), root))
+        print(os.path.relpath(write(root, a.table_runs, a.setup_runs, a.machine, a.soil_law, a.name), root))
     except DocsError as e:
         print('dm-docs-cone-setup: {}'.format(e), file=sys.stderr)
         return 1
