@@ -117,7 +117,7 @@ def _scatter(cis):
 def rows(table_runs, knobs):
     """The data file's rows: per f, the table's runs, then each knob's (see the module's text)."""
     out = []
-    fs = sorted({f for _, runs, _ in knobs for f, _ in runs})
+    fs = sorted({f for _, runs in knobs for f, _ in runs})
     for f in fs:
         seeds = sorted(s for g, s in table_runs if g == f)
         cis = [float(table_runs[(f, s)]['cone_index_psi']) for s in seeds]
@@ -128,7 +128,7 @@ def rows(table_runs, knobs):
                         first.get('container_diameter'), first.get('soil_depth'), first.get('cone_speed')),
                     'f': f, 'seeds': ', '.join(map(str, seeds)), 'ci': round(statistics.mean(cis), 1),
                     'change': '—', 'seed_scatter': _scatter(cis)})
-        for what, runs, _ in knobs:
+        for what, runs in knobs:
             mine = sorted(s for g, s in runs if g == f)
             changes = []
             for s in mine:
@@ -162,7 +162,7 @@ def write(root, table_folder, folders, machine, soil_law=None, name=None):
         if not what:
             raise DocsError('{}: made in the set-up of the table\'s runs ({}): not a set-up study\'s runs'.format(
                 folder, table_folder))
-        knobs.append((what, runs, options.get('--set') or []))
+        knobs.append((what, runs))
         commits |= {str(r.get('kept_from_commit', '?')) for r in runs.values()}
     name = name or 'setup_d{:g}'.format(d)
     data = {
